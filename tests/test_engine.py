@@ -1,0 +1,145 @@
+"""Real LAMMPS runs (seconds each): packing statistics, a tiny UCS test, an unloaded specimen,
+and the runner's failure detection. These use the engine installed by `make setup`."""
+
+from __future__ import annotations
+
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from deckgen.deck import render_case
+from deckgen.packing import ensure_packing, load_packing
+from deckgen.parse.series import read_series
+from deckgen.runner import EngineError, engine_command, run_deck
+from deckgen.spec import load_case
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ROOT / "tests" / "data" / "cases"
+
+pytestmark = pytest.mark.engine
+
+
+def _lmp_ok() -> bool:
+    try:
+        cmd = engine_command(1)
+    except EngineError:
+        return False
+    return shutil.which(cmd[0]) is not None or Path(cmd[0]).exists()
+
+
+if not _lmp_ok():  # pragma: no cover
+    pytest.skip("no LAMMPS binary (run `make setup`)", allow_module_level=True)
+
+
+@pytest.fixture(scope="module")
+def cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("cache")
+
+
+@pytest.fixture(scope="module")
+def ucs_run(tmp_path_factory, cache):
+    case = load_case(CASES / "tiny_ucs.yaml")
+    out = tmp_path_factory.mktemp("ucs") / "run"
+    spec = render_case(case, out, cache=cache, progress=False)
+    res = run_deck(out, expected_steps=spec["derived"]["expected_steps"], progress=False)
+    return out, spec, res
+
+
+def test_packing_is_dense_jammed_and_cached(cache):
+    case = load_case(CASES / "tiny_ucs.yaml")
+    folder = ensure_packing(case, cache, progress=False)
+    atoms, info = load_packing(folder)
+    s = info["stats"]
+    # a jammed random packing: deflated from over-filled to small overlaps, still in contact
+    # (a tiny specimen: walls make up much of it, so the fraction is below the bulk 0.62-0.64)
+    assert 0.9 < s["radius_scale"] < 1.0
+    assert s["contact_pressure_Pa"] < 1.3 * s["contact_pressure_target_Pa"]
+    assert 0.55 < s["solid_fraction"] < 0.64
+    assert s["coordination_mean_no_rattlers"] > 5.0
+    assert s["overlap_mean_rel"] < 0.005 and s["overlap_max_rel"] < 0.02
+    assert len(atoms) == s["n_grains"] > 200
+    r_mm = atoms.radius * 1e3 / s["radius_scale"]
+    assert r_mm.min() >= 0.6 - 1e-6 and r_mm.max() <= 0.9 + 1e-6
+    # all grains inside the cylinder walls (radius 4 mm, height 16 mm) up to a small wall overlap
+    rho = np.hypot(atoms.x[:, 0], atoms.x[:, 1])
+    assert np.all(rho + atoms.radius <= 4e-3 + 0.03e-3)
+    assert np.all(atoms.x[:, 2] - atoms.radius >= -0.03e-3)
+    # cached: a second call returns the same folder without running the engine
+    stamp = (folder / "packing.json").stat().st_mtime_ns
+    assert ensure_packing(case, cache, progress=False, command=["false"]) == folder
+    assert (folder / "packing.json").stat().st_mtime_ns == stamp
+
+
+def test_tiny_ucs_peak_and_post_peak_breakage(ucs_run):
+    out, spec, res = ucs_run
+    s = read_series(out / "series.txt")
+    assert res.steps > 1000 and res.particle_steps_per_s > 0
+    i = int(s["stress_Pa"].idxmax())
+    peak = float(s["stress_Pa"].iloc[i])
+    assert math.isfinite(peak) and peak > 1e6, peak  # at least 1 MPa for 10 GPa bonds of 30 MPa
+    assert peak < 200e6
+    bonds = s["bonds"].to_numpy()
+    n0 = spec["derived"]["n_bonds"]
+    assert bonds[0] == n0
+    # the specimen failed: the run stopped after the peak with more bonds broken than at the peak
+    assert bonds[-1] < bonds[i]
+    assert float(s["stress_Pa"].iloc[-1]) < 0.8 * peak
+    # the pre-peak branch rises: a positive modulus from 20-50 % of the peak
+    pre = s.iloc[: i + 1]
+    win = pre[(pre.stress_Pa > 0.2 * peak) & (pre.stress_Pa < 0.5 * peak)]
+    slope = np.polyfit(win["strain"], win["stress_Pa"], 1)[0]
+    assert slope > 1e8
+    # the platens balance: bottom and top forces agree before the peak (quasi-static)
+    mid = pre[(pre.stress_Pa > 0.4 * peak) & (pre.stress_Pa < 0.6 * peak)]
+    ratio = (mid.force_bottom_N / -mid.force_top_N).mean()
+    assert ratio == pytest.approx(1.0, abs=0.1)
+
+
+def test_unloaded_specimen_keeps_all_bonds(ucs_run, tmp_path):
+    """No loading for 20000 steps at the computed dt: spontaneous breakage would show an unstable dt."""
+    src, spec, _ = ucs_run
+    out = tmp_path / "rest"
+    out.mkdir()
+    for f in ("in.deck", "specimen.data"):
+        shutil.copy(src / f, out / f)
+    cmd = engine_command() + ["-var", "v_platen", "0.0", "-var", "chunk", "4000", "-var", "nchunks", "5",
+                              "-var", "stop_frac", "-1.0e9"]
+    res = run_deck(out, command=cmd, progress=False)
+    assert res.steps >= 20000
+    s = read_series(out / "series.txt")
+    assert (s["bonds"] == spec["derived"]["n_bonds"]).all()
+    assert s["ke_J"].iloc[-1] < 1e-3  # no energy pumped in by an unstable step
+
+
+def test_runner_reports_engine_error_line(tmp_path):
+    (tmp_path / "in.deck").write_text("units si\nbogus_command 1 2 3\n")
+    with pytest.raises(EngineError, match=r"log\.lammps:\d+: ERROR.*[Uu]nknown command.*bogus_command"):
+        run_deck(tmp_path, command=engine_command(1), progress=False)
+
+
+def test_runner_reports_lost_atoms(tmp_path):
+    (tmp_path / "in.deck").write_text(
+        "units si\natom_style sphere\nboundary f f f\nregion b block 0 1 0 1 0 1 units box\ncreate_box 1 b\n"
+        "create_atoms 1 single 0.5 0.5 0.5 units box\nset atom 1 diameter 0.1 density 1000\n"
+        "velocity all set 100 0 0 units box\npair_style zero 1.0\npair_coeff * *\nfix 1 all nve/sphere\n"
+        "timestep 0.001\nthermo 1\nrun 20\n")
+    with pytest.raises(EngineError, match=r"log\.lammps:\d+: ERROR: Lost atoms: original 1 current 0"):
+        run_deck(tmp_path, command=engine_command(1), progress=False)
+
+
+def test_cli_render_and_stl(tmp_path, cache, capsys):
+    from deckgen.cli import main
+
+    assert main(["stl", str(CASES / "tiny_cut.yaml"), "--out", str(tmp_path / "c.stl")]) == 0
+    assert "diameter 12.000 mm" in capsys.readouterr().out
+    assert (tmp_path / "c.stl").read_bytes()[:5] != b"solid"
+    assert main(["render", str(CASES / "tiny_bts.yaml"), "--out", str(tmp_path / "bts"), "--cache", str(cache),
+                 "--no-progress"]) == 0
+    spec = json.loads((tmp_path / "bts" / "spec.json").read_text())
+    assert spec["case"]["test"] == "bts"
+    # BTS stress area: sigma_t = 2F/(pi D t)  ->  area = pi D t / 2
+    assert spec["derived"]["area_m2"] == pytest.approx(math.pi * 10e-3 * 5e-3 / 2)

@@ -1,0 +1,126 @@
+"""Deck rendering: filters keep case strings out of decks; golden decks; resolved spec beside the deck."""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from deckgen.render import DeckError, f_comment, f_num, f_path, f_tok, render
+
+ROOT = Path(__file__).resolve().parents[1]
+GOLDEN = ROOT / "tests" / "data" / "golden"
+
+
+def _regen():
+    spec = importlib.util.spec_from_file_location("regenerate", GOLDEN / "regenerate.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), "1; shell ls", True, None, [1]])
+def test_num_filter_rejects_non_numbers(bad):
+    with pytest.raises(DeckError):
+        f_num(bad)
+
+
+def test_num_filter_formats():
+    assert f_num(2650) == "2650"
+    assert f_num(1.0e-8) == "1e-08"
+    assert f_num(math.pi) == "3.141592654"
+
+
+@pytest.mark.parametrize("bad", ["a b", "x;shell rm", "$(v_x)", "${x}", "a\nshell ls", "../x", "", "\"q\"", "a&b"])
+def test_token_filter_rejects_injection(bad):
+    with pytest.raises(DeckError):
+        f_tok(bad)
+
+
+def test_path_and_comment_filters():
+    assert f_path("specimen.data") == "specimen.data"
+    for bad in ["/etc/passwd", "../up.data", "a b.data"]:
+        with pytest.raises(DeckError):
+            f_path(bad)
+    with pytest.raises(DeckError):
+        f_comment("text $(shell) here")
+    with pytest.raises(DeckError):
+        f_comment("two\nlines")
+
+
+def test_strict_undefined():
+    import jinja2
+
+    with pytest.raises(jinja2.UndefinedError):
+        render("lammps/ucs.lmp.j2", {"version": "0.1.0"})
+
+
+@pytest.mark.parametrize("name", ["tiny_ucs", "tiny_bts", "tiny_cut"])
+def test_golden_deck(tmp_path, name):
+    """Rendering the tiny case against its committed packing reproduces the committed deck exactly.
+
+    After an intentional change: python tests/data/golden/regenerate.py, and review the diff.
+    """
+    out = tmp_path / "run"
+    _regen().render_golden(name, out, tmp_path / "cache")
+    expected = (GOLDEN / name / "in.deck").read_text()
+    got = (out / "in.deck").read_text()
+    assert got == expected
+    assert json.loads((out / "spec.json").read_text()) == json.loads((GOLDEN / name / "spec.json").read_text())
+    # relative paths only, and every file the deck reads exists in the run folder
+    assert "/tmp" not in got and str(ROOT) not in got
+    assert (out / "specimen.data").is_file()
+    spec = json.loads((out / "spec.json").read_text())
+    assert spec["case"]["name"] == name
+    assert spec["derived"]["dt_s"] > 0
+    # the parameters are a commented variable block at the top
+    lines = [ln for ln in got.splitlines() if ln.startswith("variable ") and " index " in ln]
+    assert len(lines) >= 14 and all("#" in ln and "[" in ln for ln in lines)
+
+
+def test_golden_cut_geometry(tmp_path):
+    out = tmp_path / "run"
+    _regen().render_golden("tiny_cut", out, tmp_path / "cache")
+    spec = json.loads((out / "spec.json").read_text())
+    d = spec["derived"]
+    # disc of 12 mm: starts with its bottom at block top - penetration, clear of the block front
+    R = d["cutter"]["radius"]
+    assert R == pytest.approx(6e-3, rel=1e-3)
+    assert d["cutter"]["zc0"] - R == pytest.approx(8e-3 - 1.5e-3, abs=1e-9)
+    half_chord = math.sqrt(R**2 - (R - 1.5e-3) ** 2)
+    assert d["cutter"]["xc0"] + half_chord == pytest.approx(-1e-3, abs=1e-9)  # start_clearance_mm 1.0
+    assert d["cutter"]["spin_rate"] == pytest.approx(2.0 / R)  # rolling: v / R
+    # shell spheres sit on the STL offset inward by their radius
+
+    n_shell = d["n_shell"]
+    lines = (out / "specimen.data").read_text().split("Atoms # bpm/sphere")[1].split("Bonds")[0].strip().splitlines()
+    shell = [ln.split() for ln in lines if ln.split()[2] == "2"]
+    assert len(shell) == n_shell > 300
+    import numpy as np
+
+    from deckgen.geometry import v_disc
+
+    # distance of each shell centre to the true cutter profile (rho, a) = (sqrt(x^2 + z^2), y)
+    pts = np.array([[float(v) for v in s[5:8]] for s in shell]) - [d["cutter"]["xc0"], d["cutter"]["yc0"], d["cutter"]["zc0"]]
+    q = np.stack([np.hypot(pts[:, 0], pts[:, 2]), pts[:, 1]], axis=1)
+    prof = v_disc(12e-3, 60.0, 0.3e-3, 4e-3)
+    a, b = prof, np.roll(prof, -1, axis=0)
+    ab = b - a
+    t = np.clip(((q[:, None, :] - a) * ab).sum(-1) / np.maximum((ab * ab).sum(-1), 1e-30), 0, 1)
+    dist = np.linalg.norm(q[:, None, :] - (a + t[..., None] * ab), axis=-1).min(axis=1)
+    assert np.allclose(dist, d["shell_radius_m"], atol=0.01e-3), (dist.min(), dist.max())
+
+
+def test_specimen_data_is_deterministic(tmp_path):
+    """Same case, same packing -> byte-identical bonded data file."""
+    regen = _regen()
+    digests = []
+    for k in range(2):
+        out = tmp_path / f"run{k}"
+        regen.render_golden("tiny_ucs", out, tmp_path / f"cache{k}")
+        digests.append(hashlib.sha256((out / "specimen.data").read_bytes()).hexdigest())
+    assert digests[0] == digests[1]

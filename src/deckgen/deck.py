@@ -50,6 +50,10 @@ def effective_modulus(E1: float, nu1: float, E2: float, nu2: float, nu_deck: flo
     return 2.0 * (1.0 - nu_deck**2) * e_star
 
 
+def _round_up(n: int, quantum: int) -> int:
+    return -(-int(n) // quantum) * quantum
+
+
 def _var(name: str, value: float | int, comment: str, unit: str) -> dict[str, Any]:
     return {"name": name, "value": value, "comment": comment, "unit": unit}
 
@@ -195,6 +199,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     skin = 0.3 * r_max
     ghost = 2.0 * float(r_full.max()) * (1.0 + b.gap_tolerance) + 2 * skin
 
+    quantum = math.lcm(case.outputs.series_every, case.outputs.broken_every)
     variables = [
         _var("rho", rho, "grain density (x mass scaling)", "kg/m^3"),
         _var("E_c", E_c, "grain Young's modulus, Hertz contact", "Pa"),
@@ -243,7 +248,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             area = math.pi * sp.diameter_mm * MM * sp.thickness_mm * MM / 2.0  # sigma_t = F / area = 2F/(pi D t)
             title = "Brazilian test of a bonded disc"
         v = sp.platen_speed_m_s
-        chunk = max(100, int(round(1e-3 * height / v / dt / 10)) * 10 or 100)  # stop check every ~0.1 % strain
+        # stop check every ~0.01 % strain, on a multiple of the output intervals so nothing is lost
+        chunk = _round_up(max(100, int(1e-4 * height / v / dt)), quantum)
         total = int(math.ceil(sp.max_strain * height / v / dt))
         if total > run.max_steps:
             raise SpecError(f"run.max_steps: the test needs {total} steps at dt {dt:.3g} s "
@@ -261,6 +267,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("chunk", chunk, "steps between stop checks", "steps"),
             _var("nchunks", nchunks, "stop checks at most (max strain)", "1"),
             _var("stop_frac", sp.stop_fraction_of_peak, "stop below this fraction of the peak", "1"),
+            _var("nb_stop", math.floor(0.995 * len(pairs)), "and only once 0.5 pct of the bonds broke", "1"),
             _var("dump_every", case.outputs.dump_every or max(1, nchunks * chunk // 10), "per-atom dump interval", "steps"),
         ]
         derived.update({"height_m": height, "area_m2": area, "lateral_size_m": lateral, "platen_speed_m_s": v,
@@ -294,7 +301,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         lo[2] = min(lo[2], -pad)
         hi[2] = max(hi[2], path["zc0"] + R + 2 * path["ecc"] + pad)
         box = np.stack([lo, hi], axis=1)
-        steps = int(math.ceil(path["duration"] / dt))
+        steps = _round_up(int(math.ceil(path["duration"] / dt)), quantum)
         if steps > run.max_steps:
             raise SpecError(f"run.max_steps: the cut needs {steps} steps at dt {dt:.3g} s "
                             f"(fix: raise run.max_steps, shorten kinematics.travel_mm or raise speed_m_s)")

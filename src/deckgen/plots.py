@@ -1,0 +1,167 @@
+"""PNG plots of one parsed run (a folder written by :func:`deckgen.results.parse_run`).
+
+Uses matplotlib's object API with the Agg canvas (no pyplot, no global backend switch, safe in
+worker processes). File names are ``<case>_<kind>.png``:
+
+platen tests (UCS, BTS)
+    ``stress_strain`` (stress in MPa over strain in %, peak marked, modulus fit window and line),
+    ``broken_bonds`` (cumulative broken bonds over time, by failure mode).
+cutting
+    ``forces_time`` (normal, rolling and side force over time; steady window shaded, its means
+    as dashed lines), ``forces_x`` (the same over the cutter x position; over the penetration for
+    indentation: ``forces_penetration``), ``broken_bonds`` (cumulative, by failure mode).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from deckgen.results import read_table
+
+__all__ = ["plot_run"]
+
+_COLORS = {"force_normal_N": "tab:blue", "force_rolling_N": "tab:red", "force_side_N": "tab:green",
+           "tension": "tab:orange", "shear": "tab:purple", "unknown": "tab:gray", "total": "black"}
+_LABELS = {"force_normal_N": "normal $F_n = F_z$", "force_rolling_N": "rolling $F_r = -F_x$",
+           "force_side_N": "side $F_s = F_y$"}
+
+
+def _figure() -> tuple[Figure, Any]:
+    fig = Figure(figsize=(7.0, 4.5), dpi=120, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot(1, 1, 1)
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
+    return path
+
+
+def _finite(v: Any) -> bool:
+    return isinstance(v, (int, float)) and v is not None and math.isfinite(float(v))
+
+
+def _title(summary: dict[str, Any], what: str) -> str:
+    return f"{summary['case']} ({summary['test']}, {summary['engine']}): {what}"
+
+
+def _broken_plot(summary: dict[str, Any], bt: pd.DataFrame, path: Path) -> Path:
+    fig, ax = _figure()
+    t_ms = bt["time_s"].to_numpy() * 1e3
+    ax.plot(t_ms, bt["bonds_broken"], color=_COLORS["total"], lw=1.8, label="all")
+    for m in ("tension", "shear", "unknown"):
+        col = f"bonds_broken_{m}"
+        if len(bt) and bt[col].iloc[-1] > 0:
+            ax.plot(t_ms, bt[col], color=_COLORS[m], lw=1.2, label=m)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("broken bonds (cumulative)")
+    n0 = summary.get("n_bonds_initial")
+    if _finite(n0) and n0:
+        sec = ax.secondary_yaxis("right", functions=(lambda b: 100.0 * b / n0, lambda p: p * n0 / 100.0))
+        sec.set_ylabel("broken fraction (%)")
+    src = summary.get("mode_source", "none")
+    ax.set_title(_title(summary, "broken bonds" + ("" if src != "none" else " (modes unknown: no bond samples)")))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left")
+    return _save(fig, path)
+
+
+def _stress_strain(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
+    fig, ax = _figure()
+    strain_pct = ts["strain_1"].to_numpy() * 100.0
+    stress_mpa = ts["stress_Pa"].to_numpy() / 1e6
+    label = "Brazilian tensile stress 2F/($\\pi$Dt)" if summary["test"] == "bts" else "axial stress"
+    ax.plot(strain_pct, stress_mpa, color="tab:blue", lw=1.2, label=label)
+    if _finite(summary.get("peak_stress_Pa")):
+        ax.plot([summary["strain_at_peak_1"] * 100], [summary["peak_stress_Pa"] / 1e6], "o", color="tab:red",
+                label=f"peak {summary['peak_stress_Pa'] / 1e6:.3g} MPa")
+    key = "youngs_modulus_Pa" if summary["test"] == "ucs" else "secant_modulus_Pa"
+    E, b = summary.get(key), summary.get("modulus_fit_intercept_Pa")
+    if _finite(E) and _finite(b):
+        lo, hi = summary["modulus_fit_stress_lo_Pa"], summary["modulus_fit_stress_hi_Pa"]
+        ax.axhspan(lo / 1e6, hi / 1e6, color="0.85", alpha=0.6, label="fit window 20-50 % of peak")
+        eps = np.array([(lo - b) / E, (hi - b) / E])
+        name = "E" if summary["test"] == "ucs" else "secant modulus"
+        ax.plot(eps * 100, (E * eps + b) / 1e6, "--", color="black", lw=1.0, label=f"{name} {E / 1e9:.3g} GPa")
+    ax.set_xlabel("strain (%)" if summary["test"] == "ucs" else "diametral strain (%)")
+    ax.set_ylabel("stress (MPa)")
+    ax.set_title(_title(summary, "stress-strain"))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best")
+    return _save(fig, path)
+
+
+def _forces_time(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
+    fig, ax = _figure()
+    t_ms = ts["time_s"].to_numpy() * 1e3
+    a, b = summary.get("steady_start_s"), summary.get("steady_end_s")
+    if _finite(a) and _finite(b):
+        ax.axvspan(a * 1e3, b * 1e3, color="0.9", label="steady window")
+    for q in ("force_normal_N", "force_rolling_N", "force_side_N"):
+        ax.plot(t_ms, ts[q], color=_COLORS[q], lw=0.9, label=_LABELS[q])
+        m = summary.get(f"{q}_mean_steady")
+        if _finite(m) and _finite(a) and _finite(b):
+            ax.hlines(m, a * 1e3, b * 1e3, colors=_COLORS[q], linestyles="--", lw=1.6,
+                      label=f"mean {m:.3g} N")
+    ax.axhline(0.0, color="black", lw=0.5)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("force on the cutter (N)")
+    ax.set_title(_title(summary, "cutting forces"))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small", ncols=2)
+    return _save(fig, path)
+
+
+def _forces_x(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
+    fig, ax = _figure()
+    indent = summary.get("kinematics_mode") == "indentation"
+    if indent:
+        x = ts["penetration_m"].to_numpy() * 1e3
+        ax.set_xlabel("penetration (mm)")
+    else:
+        x = ts["cutter_x_m"].to_numpy() * 1e3
+        ax.set_xlabel("cutter centre x (mm)")
+        a, b = summary.get("steady_start_s"), summary.get("steady_end_s")
+        t = ts["time_s"].to_numpy()
+        mask = (t >= a) & (t <= b) if _finite(a) and _finite(b) else np.zeros(len(t), bool)
+        if mask.any():
+            ax.axvspan(x[mask].min(), x[mask].max(), color="0.9", label="steady window")
+    for q in ("force_normal_N", "force_rolling_N", "force_side_N"):
+        ax.plot(x, ts[q], color=_COLORS[q], lw=0.9, label=_LABELS[q])
+    ax.axhline(0.0, color="black", lw=0.5)
+    ax.set_ylabel("force on the cutter (N)" if not indent else "force on the indenter (N)")
+    ax.set_title(_title(summary, "forces vs penetration" if indent else "forces vs cutter position"))
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    return _save(fig, path)
+
+
+def plot_run(parsed_dir: str | Path, plots_dir: str | Path) -> list[Path]:
+    """Write the PNG plots of one parsed run into ``plots_dir``; return their paths."""
+    parsed_dir = Path(parsed_dir)
+    plots_dir = Path(plots_dir)
+    sp = parsed_dir / "summary.json"
+    if not sp.is_file():
+        raise FileNotFoundError(f"{sp}: no summary.json (run deckgen parse first)")
+    summary = {k: (float("nan") if v is None else v) for k, v in json.loads(sp.read_text()).items()}
+    ts = read_table(parsed_dir / "timeseries")
+    bt = read_table(parsed_dir / "broken_timeseries")
+    case = summary["case"]
+    out: list[Path] = []
+    if summary["test"] in ("ucs", "bts"):
+        out.append(_stress_strain(summary, ts, plots_dir / f"{case}_stress_strain.png"))
+    else:
+        out.append(_forces_time(summary, ts, plots_dir / f"{case}_forces_time.png"))
+        kind = "forces_penetration" if summary.get("kinematics_mode") == "indentation" else "forces_x"
+        out.append(_forces_x(summary, ts, plots_dir / f"{case}_{kind}.png"))
+    out.append(_broken_plot(summary, bt, plots_dir / f"{case}_broken_bonds.png"))
+    return out

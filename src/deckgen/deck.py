@@ -241,27 +241,35 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     if isinstance(case.specimen, (UcsCylinder, BrazilianDisc)):
         sp = case.specimen
         if isinstance(sp, UcsCylinder):
-            height, area, lateral = sp.height_mm * MM, math.pi * (sp.diameter_mm * MM / 2) ** 2, sp.diameter_mm * MM
+            area, lateral = math.pi * (sp.diameter_mm * MM / 2) ** 2, sp.diameter_mm * MM
             title = "uniaxial compression of a bonded cylinder"
         else:
-            height, lateral = sp.diameter_mm * MM, sp.diameter_mm * MM
+            lateral = sp.diameter_mm * MM
             area = math.pi * sp.diameter_mm * MM * sp.thickness_mm * MM / 2.0  # sigma_t = F / area = 2F/(pi D t)
             title = "Brazilian test of a bonded disc"
+        # platens touch the extreme grains (after the shrink before bonding): loading starts at t = 0
+        z_bot = float((atoms.x[:, 2] - r).min())
+        z_top = float((atoms.x[:, 2] + r).max())
+        height = z_top - z_bot
         v = sp.platen_speed_m_s
         # stop check every ~0.01 % strain, on a multiple of the output intervals so nothing is lost
         chunk = _round_up(max(100, int(1e-4 * height / v / dt)), quantum)
-        total = int(math.ceil(sp.max_strain * height / v / dt))
+        # velocity ramp: 10 round trips of a P-wave at the bond modulus (an upper bound of the speed)
+        c_wave = math.sqrt(b.youngs_modulus_GPa * GPA / rho)
+        t_ramp = sp.ramp_time_s if sp.ramp_time_s is not None else 10.0 * 2.0 * height / c_wave
+        total = int(math.ceil((sp.max_strain * height / v + 0.5 * t_ramp) / dt))
         if total > run.max_steps:
             raise SpecError(f"run.max_steps: the test needs {total} steps at dt {dt:.3g} s "
                             f"(fix: raise run.max_steps, platen_speed_m_s or mass_scaling)")
         nchunks = max(1, math.ceil(total / chunk))
-        box[2] = (-pad, height + pad)
+        box[2] = (z_bot - pad, z_top + pad)
         variables += [
-            _var("z_bot", 0.0, "bottom platen position", "m"),
-            _var("z_top", height, "top platen start position", "m"),
+            _var("z_bot", z_bot, "bottom platen position (lowest grain)", "m"),
+            _var("z_top", z_top, "top platen start position (highest grain)", "m"),
             _var("v_platen", v, "top platen speed (down)", "m/s"),
+            _var("t_ramp", t_ramp, "platen velocity ramp time (10 P-wave round trips)", "s"),
             _var("area", area, "stress area (UCS pi R^2, BTS pi D t / 2)", "m^2"),
-            _var("height", height, "specimen height along the load", "m"),
+            _var("height", height, "specimen height along the load (between the platens)", "m"),
             _var("E_platen", effective_modulus(E_c, nu_c, E_s, nu_s, nu_c), "platen-grain Hertz modulus", "Pa"),
             _var("mu_platen", c.platen_friction, "platen friction", "1"),
             _var("chunk", chunk, "steps between stop checks", "steps"),
@@ -270,7 +278,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("nb_stop", math.floor(0.995 * len(pairs)), "and only once 0.5 pct of the bonds broke", "1"),
             _var("dump_every", case.outputs.dump_every or max(1, nchunks * chunk // 10), "per-atom dump interval", "steps"),
         ]
-        derived.update({"height_m": height, "area_m2": area, "lateral_size_m": lateral, "platen_speed_m_s": v,
+        derived.update({"height_m": height, "area_m2": area, "lateral_size_m": lateral, "platen_speed_m_s": v, "platen_ramp_s": t_ramp,
                         "expected_steps": nchunks * chunk})
         template = {"ucs_cylinder": "lammps/ucs.lmp.j2", "brazilian_disc": "lammps/bts.lmp.j2"}[sp.kind]
     else:

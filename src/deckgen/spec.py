@@ -133,6 +133,9 @@ class UcsCylinder(_Model):
     diameter_mm: float = _f(20.0, "mm", "Cylinder diameter.", gt=0)
     height_mm: float = _f(40.0, "mm", "Cylinder height (H/D = 2 is the ISRM shape).", gt=0)
     platen_speed_m_s: float = _f(0.05, "m/s", "Top platen speed.", gt=0, le=10)
+    ramp_time_s: float | None = _f(
+        None, "s", "Platen velocity ramp-up time (default: 10 round trips of a P-wave at the bond modulus).", gt=0
+    )
     max_strain: float = _f(0.012, "1", "Stop at this axial strain at the latest.", gt=0, lt=0.5)
     stop_fraction_of_peak: float = _f(0.6, "1", "Stop once the stress fell below this fraction of its peak.", gt=0, lt=1)
 
@@ -144,6 +147,9 @@ class BrazilianDisc(_Model):
     diameter_mm: float = _f(20.0, "mm", "Disc diameter.", gt=0)
     thickness_mm: float = _f(10.0, "mm", "Disc thickness (t/D = 0.5 is the ISRM shape).", gt=0)
     platen_speed_m_s: float = _f(0.05, "m/s", "Top platen speed.", gt=0, le=10)
+    ramp_time_s: float | None = _f(
+        None, "s", "Platen velocity ramp-up time (default: 10 round trips of a P-wave at the bond modulus).", gt=0
+    )
     max_strain: float = _f(0.02, "1", "Stop at this diametral strain at the latest.", gt=0, lt=0.5)
     stop_fraction_of_peak: float = _f(0.5, "1", "Stop once the load fell below this fraction of its peak.", gt=0, lt=1)
 

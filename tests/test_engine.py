@@ -143,3 +143,24 @@ def test_cli_render_and_stl(tmp_path, cache, capsys):
     assert spec["case"]["test"] == "bts"
     # BTS stress area: sigma_t = 2F/(pi D t)  ->  area = pi D t / 2
     assert spec["derived"]["area_m2"] == pytest.approx(math.pi * 10e-3 * 5e-3 / 2)
+
+
+def test_indentation_kinematics_and_contact(tmp_path, cache):
+    """The shell follows z_c = z_c0 - v t exactly; the normal force appears only after contact."""
+    case = load_case(CASES / "tiny_indent.yaml")
+    out = tmp_path / "indent"
+    spec = render_case(case, out, cache=cache, progress=False)
+    cut = spec["derived"]["cutter"]
+    assert cut["mode_indent"] == 1.0
+    assert cut["yc0"] == pytest.approx(-6e-3 + 4e-3)  # cut spacing from the free y-min face
+    run_deck(out, expected_steps=spec["derived"]["expected_steps"], progress=False)
+    s = read_series(out / "series.txt").drop_duplicates("step", keep="last")
+    assert np.allclose(s["cutter_z_m"], cut["zc0"] - cut["V"] * s["time_s"], atol=1e-12, rtol=0)
+    assert np.allclose(s["cutter_x_m"], cut["xc0"], atol=1e-15)
+    # the tip reaches the block top (z = 8 mm) after the start clearance: no force before that
+    gap = (cut["zc0"] - cut["radius"]) - 8e-3
+    before = s[cut["V"] * s["time_s"] < gap - 0.05e-3]
+    assert len(before) > 5 and (before[["force_x_N", "force_y_N", "force_z_N"]].abs().max() < 1e-9).all()
+    after = s[cut["V"] * s["time_s"] > gap + 0.5e-3]
+    assert len(after) > 5 and after["force_z_N"].max() > 1.0  # the rock pushes the disc up
+    assert s["bonds"].iloc[-1] < spec["derived"]["n_bonds"]  # the indentation broke bonds

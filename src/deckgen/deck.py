@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -27,7 +26,7 @@ from deckgen.bonds import (
 from deckgen.datafile import write_bpm_data
 from deckgen.packing import ensure_packing, load_packing, specimen_region
 from deckgen.render import render
-from deckgen.spec import DEG, GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
+from deckgen.spec import GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
 
 DECK = "in.deck"
 DATA = "specimen.data"

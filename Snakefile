@@ -12,6 +12,7 @@ include: "workflow/rules/run.smk"
 include: "workflow/rules/parse.smk"
 include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/plot.smk"
+include: "workflow/rules/calibrate.smk"
 
 
 rule all:

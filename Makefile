@@ -10,9 +10,16 @@ STAMP  := $(VENV)/.deckgen-installed
 CORES  ?= 2
 export PATH := $(abspath $(BIN)):$(PATH)
 
-.PHONY: setup run test lint schema clean-results
+.PHONY: setup run test lint schema clean-results liggghts
 
-setup: $(STAMP)
+setup: $(STAMP) liggghts
+
+# Debian's LIGGGHTS-PUBLIC 3.8 (unbonded granular runs of the LIGGGHTS backend). If apt cannot install
+# it, set-up goes on with a warning and the LIGGGHTS tests skip with that reason.
+liggghts:
+	@command -v liggghts >/dev/null 2>&1 || { \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends liggghts) >/dev/null 2>&1 \
+	  || echo "WARNING: could not install Debian's liggghts (apt-get); LIGGGHTS tests will be skipped"; }
 
 $(STAMP): requirements.lock pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

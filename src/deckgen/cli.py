@@ -85,14 +85,21 @@ def cmd_pack(args: argparse.Namespace) -> int:
 
 def cmd_render(args: argparse.Namespace) -> int:
     from deckgen.deck import render_case
-    from deckgen.spec import load_case
+    from deckgen.spec import SpecError, load_case
 
     case = load_case(args.case)
     if args.engine and args.engine != case.engine:
         case = case.model_copy(update={"engine": args.engine})
-    if case.engine != "lammps":
-        raise SystemExit(f"deckgen: error: {args.case}: engine {case.engine}: only the lammps backend exists yet "
-                         "(fix: engine: lammps)")
+    if case.engine == "liggghts":
+        from deckgen import liggghts as lg
+
+        render_fn = {"cutting": lg.render_liggghts_cut, "ucs": lg.render_liggghts_ucs_bonded}.get(case.test)
+        if render_fn is None:
+            raise SpecError(f"{args.case}: engine: liggghts renders cutting beds and bonded UCS decks so far, "
+                            f"not {case.test} (fix: engine: lammps)")
+        render_fn(case, Path(args.out))
+        print(f"{args.case}: rendered {args.out}/{lg.DECK} for LIGGGHTS")
+        return 0
     spec = render_case(case, Path(args.out), cache=_cache(args), progress=not args.no_progress, command=_command(args))
     d = spec["derived"]
     print(f"{args.case}: rendered {args.out}/in.deck: {d['n_grains']} grains, {d['n_bonds']} bonds in "
@@ -105,11 +112,18 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     run_dir = Path(args.dir)
     spec_file = run_dir / "spec.json"
-    expected = None
+    expected, engine = None, "lammps"
     if spec_file.is_file():
-        expected = json.loads(spec_file.read_text())["derived"].get("expected_steps")
-    res = run_deck(run_dir, args.deck, expected_steps=expected, command=_command(args),
-                   progress=not args.no_progress, label=run_dir.name)
+        spec = json.loads(spec_file.read_text())
+        expected, engine = spec["derived"].get("expected_steps"), spec.get("engine", "lammps")
+    if engine == "liggghts":
+        from deckgen.liggghts import run_liggghts
+
+        res = run_liggghts(run_dir, ranks=args.ranks, command=shlex.split(args.engine_cmd) if args.engine_cmd else None,
+                           progress=not args.no_progress)
+    else:
+            res = run_deck(run_dir, args.deck, expected_steps=expected, command=_command(args),
+                       progress=not args.no_progress, label=run_dir.name)
     pss = f"{res.particle_steps_per_s:.3g}" if res.particle_steps_per_s else "n/a"
     print(f"{run_dir}: {res.steps} steps, {res.atoms} atoms, {res.wall_s:.1f} s wall, {pss} particle-steps/s")
     return 0

@@ -232,6 +232,8 @@ class _RunState:
         self.loop_s: float = _nan()
         self.particle_steps_per_s: float = _nan()
         log = run_dir / "log.lammps"
+        if not log.is_file() and (run_dir / "log.liggghts").is_file():
+            log = run_dir / "log.liggghts"
         run_json = run_dir / "run.json"
         health = None
         if log.is_file():

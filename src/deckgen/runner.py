@@ -92,6 +92,12 @@ def _last_step(fh, last: int) -> int:
     return last
 
 
+def _stderr_tail(run_dir: Path) -> list[str]:
+    """Last engine stderr lines, without OpenMPI's harmless component-loading noise."""
+    lines = (run_dir / "engine.stderr").read_text(errors="replace").strip().splitlines()
+    return [ln for ln in lines if "mca_base_component_repository_open" not in ln][-3:]
+
+
 def run_deck(
     run_dir: str | Path,
     deck: str = "in.deck",
@@ -102,13 +108,14 @@ def run_deck(
     progress: bool = True,
     label: str | None = None,
     timeout_s: float | None = None,
+    screen: str = "none",
 ) -> RunResult:
     """Run ``deck`` in ``run_dir``; raise :class:`EngineError` on ERROR, lost atoms, NaN or a crash."""
     run_dir = Path(run_dir)
     if not (run_dir / deck).is_file():
         raise EngineError(f"{run_dir / deck}: deck not found (fix: render it first)")
     cmd = list(command) if command else engine_command()
-    argv = cmd + ["-in", deck, "-log", log, "-screen", "none", "-nocite"]
+    argv = cmd + ["-in", deck, "-log", log, "-screen", screen, "-nocite"]
     logpath = run_dir / log
     if logpath.exists():
         logpath.unlink()
@@ -145,19 +152,19 @@ def run_deck(
                 proc.kill()
     wall = time.perf_counter() - t0
     if not logpath.exists():
-        tail = (run_dir / "engine.stderr").read_text(errors="replace").strip().splitlines()[-3:]
+        tail = _stderr_tail(run_dir)
         raise EngineError(f"{run_dir}: engine wrote no log (exit {proc.returncode}): {' | '.join(tail) or argv[0]}")
     health = check_log(logpath)
     if not health.ok:
         raise EngineError(health.failure() or f"{logpath}: engine failed")
     if proc.returncode != 0:
-        tail = (run_dir / "engine.stderr").read_text(errors="replace").strip().splitlines()[-3:]
+        tail = _stderr_tail(run_dir)
         raise EngineError(f"{logpath}: engine exited with code {proc.returncode}: {' | '.join(tail)}")
     result = RunResult(
         run_dir=str(run_dir), deck=deck, command=cmd, returncode=proc.returncode, wall_s=wall,
         steps=health.total_steps, atoms=health.atoms, loop_s=health.loop_seconds,
         particle_steps_per_s=health.particle_steps_per_s,
-        warnings=[w.text for w in health.warnings][:20],
+        warnings=sorted({w.text for w in health.warnings})[:20],
     )
     (run_dir / "run.json").write_text(json.dumps(result.as_dict(), indent=2) + "\n")
     return result

@@ -5,7 +5,6 @@ DEM evaluation (marked ``engine``)."""
 from __future__ import annotations
 
 import math
-import shutil
 import time
 from pathlib import Path
 
@@ -242,13 +241,9 @@ def test_cli_with_stand_in(tmp_path, capsys):
 
 # ------------------------------------------------------------------------------------ one real DEM step
 def _lmp_ok() -> bool:
-    from deckgen.runner import EngineError, engine_command
+    from deckgen.runner import engine_available
 
-    try:
-        cmd = engine_command(1)
-    except EngineError:
-        return False
-    return shutil.which(cmd[0]) is not None or Path(cmd[0]).exists()
+    return engine_available()
 
 
 TINY_BASE = {"packing": {"radius_min_mm": 0.6, "radius_max_mm": 0.9, "steps_per_stage": 2000, "relax_steps": 4000}}

@@ -14,7 +14,7 @@ import pytest
 from deckgen.deck import render_case
 from deckgen.packing import ensure_packing, load_packing
 from deckgen.parse.series import read_series
-from deckgen.runner import EngineError, engine_command, run_deck
+from deckgen.runner import EngineError, engine_available, engine_command, run_deck
 from deckgen.spec import load_case
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,15 +23,7 @@ CASES = ROOT / "tests" / "data" / "cases"
 pytestmark = pytest.mark.engine
 
 
-def _lmp_ok() -> bool:
-    try:
-        cmd = engine_command(1)
-    except EngineError:
-        return False
-    return shutil.which(cmd[0]) is not None or Path(cmd[0]).exists()
-
-
-if not _lmp_ok():  # pragma: no cover
+if not engine_available():  # pragma: no cover
     pytest.skip("no LAMMPS binary (run `make setup`)", allow_module_level=True)
 
 

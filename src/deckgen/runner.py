@@ -55,6 +55,17 @@ def engine_command(ranks: int | None = None, engine: str = "lammps") -> list[str
     return [str(lmp)]
 
 
+def engine_available() -> bool:
+    """True when the default LAMMPS command can be found (tests skip otherwise)."""
+    from shutil import which
+
+    try:
+        cmd = engine_command(1)
+    except EngineError:
+        return False
+    return which(cmd[0]) is not None or Path(cmd[0]).exists()
+
+
 def engine_env() -> dict[str, str]:
     """The engine's environment: one OpenMP thread per MPI rank unless OMP_NUM_THREADS is set.
 

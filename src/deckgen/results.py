@@ -86,6 +86,7 @@ __all__ = [
 
 #: Column names without a unit suffix: labels, ids and counts.
 UNITLESS_COLUMNS = frozenset({
+    "chip", "chips_count", "chips_grains", "debris_grains", "body_grains", "largest_chip_grains",
     "case", "engine", "test", "mode", "step", "id", "id1", "id2", "btype", "sample_step",
     "bonds_intact", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
@@ -96,8 +97,8 @@ UNITLESS_COLUMNS = frozenset({
 })
 
 #: Suffixes that carry a unit (SI) in column names; ``_1`` = dimensionless.
-UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m_s", "_rad_s",
-                 "_per_s")
+UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m3", "_J_m3", "_m_s",
+                 "_rad_s", "_per_s")
 #: Statistic suffixes after the unit (``force_normal_N_mean_steady``).
 STAT_SUFFIXES = ("_mean_steady", "_peak")
 
@@ -710,6 +711,14 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
         if note:
             state.notes.append(note)
         summary.update(extra)
+        from deckgen.chips import analyse, initial_bonds
+
+        if derived.get("n_bonds", 0) and initial_bonds(run_dir) is not None:
+            chips, chip_summary = analyse(run_dir, broken, ts, spec)
+            summary.update(chip_summary)
+        else:
+            chips = None
+            state.notes.append("initial bonds unknown (no specimen.data, no step-0 bond sample): no chips")
     if have_broken and bonds_broken != bonds_broken_series:
         state.notes.append(f"broken list has {bonds_broken} bonds, the series' last row says {bonds_broken_series}")
     bd = dinfo["bonds_broken_dumps"]
@@ -724,6 +733,8 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
     write_table(broken, out_dir / "broken")
     write_table(bts, out_dir / "broken_timeseries")
     write_table(dmg, out_dir / "damage")
+    if test not in _PLATEN_TESTS and chips is not None:
+        write_table(chips, out_dir / "chips")
     (out_dir / "summary.json").write_text(json.dumps(_json_safe(summary), indent=2) + "\n")
     return summary
 

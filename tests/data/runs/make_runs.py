@@ -7,7 +7,7 @@ Usage (from the repository root; a few minutes on 2 idle cores: the cut is ~40k 
 Two tiny cases are built with the Python API (``deckgen.spec.Case``), rendered with
 :func:`deckgen.deck.render_case` (packing cache in a temporary folder unless ``--cache``), run with
 :func:`deckgen.runner.run_deck`, and only the files the tests read are copied next to this script
-into ``<name>/``:  spec.json, series.txt, log.lammps, run.json, atoms.dump.gz, final.dump.gz (if the
+into ``<name>/``:  spec.json, specimen.data (from the next regeneration on), series.txt, log.lammps, run.json, atoms.dump.gz, final.dump.gz (if the
 run wrote it), broken.dump.gz, bonds.dump.gz.  The full run folders stay in ``--work`` (default: a
 temporary folder that is removed).
 
@@ -44,7 +44,7 @@ from deckgen.spec import Case
 
 HERE = Path(__file__).resolve().parent
 
-KEEP = ("spec.json", "series.txt", "log.lammps", "run.json", "atoms.dump.gz", "final.dump.gz",
+KEEP = ("spec.json", "specimen.data", "series.txt", "log.lammps", "run.json", "atoms.dump.gz", "final.dump.gz",
         "broken.dump.gz", "bonds.dump.gz")
 
 #: UCS cylinder of ~300 grains. dump_every is larger than the run, so atoms.dump.gz holds only the

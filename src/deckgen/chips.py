@@ -1,0 +1,217 @@
+"""Chips and specific energy of a cutting run.
+
+Chips are connected components of the bond graph that remains at the end of the run (initial bonds
+from ``specimen.data`` minus the broken ones). The component with the most grains is the rock
+body; every other component of at least ``min_grains`` grains is a chip; smaller ones (mostly single
+grains whose bonds all broke) are debris. Volumes are bulk volumes: the grains' solid volume
+divided by the packing's solid fraction.
+
+Specific energy SE = work / volume (J/m^3 = Pa), with the work the cutter did on the rock,
+W = -integral(F . v_c dt) - integral(T_y * spin_rate dt) (F, T_y: force and torque of the rock on the
+cutter; v_c: velocity of the disc centre), and the volume either from the chips (chips + debris) or
+from the kinematics: the groove cross-section of the disc at the nominal depth times the length
+cut (travel minus the start clearance; linear and oscillation modes).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+from deckgen.parse.common import ParseError, open_text
+from deckgen.parse.dump import iter_frames
+
+CHIP_COLUMNS = ["chip", "n_grains", "solid_volume_m3", "bulk_volume_m3", "extent_x_m", "extent_y_m",
+                "extent_z_m", "centroid_x_m", "centroid_y_m", "centroid_z_m"]
+
+
+def read_bonds(path: str | Path) -> np.ndarray:
+    """Atom-id pairs of the Bonds section of a LAMMPS data file (streamed), as an (n, 2) array."""
+    path = Path(path)
+    pairs: list[tuple[int, int]] = []
+    section = False
+    with open_text(path) as fh:
+        for lineno, raw in enumerate(fh, 1):
+            line = raw.split("#", 1)[0].strip()
+            if not line:
+                continue
+            if not section:
+                section = line == "Bonds"
+                continue
+            if line[0].isalpha():
+                break
+            parts = line.split()
+            if len(parts) != 4:
+                raise ParseError(path, lineno, f"bond line needs 4 columns (id type atom1 atom2), got {len(parts)}")
+            try:
+                pairs.append((int(parts[2]), int(parts[3])))
+            except ValueError:
+                raise ParseError(path, lineno, "non-integer atom id in bond line") from None
+    return np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+def initial_bonds(run_dir: Path) -> np.ndarray | None:
+    """Initial bonds: the data file's Bonds section, else the step-0 frame of bonds.dump.gz."""
+    if (run_dir / "specimen.data").is_file():
+        return read_bonds(run_dir / "specimen.data")
+    sample = run_dir / "bonds.dump.gz"
+    if sample.is_file():
+        for frame in iter_frames(sample, ["id1", "id2"]):
+            if frame.timestep == 0:
+                return frame.data[["id1", "id2"]].to_numpy(dtype=np.int64)
+            break
+    return None
+
+
+def last_frame(run_dir: Path) -> pd.DataFrame:
+    """Final grain state: final.dump.gz, else the last frame of atoms.dump.gz (read frame by frame)."""
+    for name in ("final.dump.gz", "atoms.dump.gz"):
+        p = run_dir / name
+        if p.is_file():
+            frame = None
+            for frame in iter_frames(p, ["id", "type", "radius", "x", "y", "z"], allow_truncated_tail=True):
+                pass
+            if frame is not None:
+                return frame.data.reset_index(drop=True)
+    raise FileNotFoundError(f"{run_dir}: no final.dump.gz or atoms.dump.gz")
+
+
+def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid_fraction: float,
+               min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Chips of the remaining bond graph among rock grains (type 1) of ``atoms``.
+
+    ``bonds`` and ``broken`` hold atom-id pairs (any order). Returns the chip table (one row per chip,
+    largest first) and summary scalars.
+    """
+    rock = atoms[atoms["type"] == 1]
+    ids = rock["id"].to_numpy(dtype=np.int64)
+    index = pd.Series(np.arange(len(ids)), index=ids)
+    b = np.sort(bonds, axis=1)
+    if len(broken):
+        br = np.sort(np.asarray(broken, dtype=np.int64), axis=1)
+        gone = set(map(tuple, br.tolist()))
+        keep = np.array([tuple(p) not in gone for p in b.tolist()], dtype=bool) if len(b) else np.zeros(0, bool)
+        b = b[keep]
+    b = b[np.isin(b[:, 0], ids) & np.isin(b[:, 1], ids)] if len(b) else b
+    n = len(ids)
+    i, j = index.loc[b[:, 0]].to_numpy(), index.loc[b[:, 1]].to_numpy()
+    graph = coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
+    ncomp, label = connected_components(graph, directed=False)
+    sizes = np.bincount(label, minlength=ncomp)
+    body = int(np.argmax(sizes)) if n else -1
+    r = rock["radius"].to_numpy(dtype=float)
+    x = rock[["x", "y", "z"]].to_numpy(dtype=float)
+    vol = 4.0 / 3.0 * math.pi * r**3
+    had_bond = np.isin(ids, bonds.ravel())
+    rows = []
+    debris_grains, debris_solid = 0, 0.0
+    for c in np.argsort(-sizes):
+        if c == body:
+            continue
+        sel = label == c
+        if sizes[c] < min_grains:
+            keep = sel & had_bond
+            debris_grains += int(keep.sum())
+            debris_solid += float(vol[keep].sum())
+            continue
+        lo, hi = (x[sel] - r[sel, None]).min(axis=0), (x[sel] + r[sel, None]).max(axis=0)
+        solid = float(vol[sel].sum())
+        cen = (x[sel] * vol[sel, None]).sum(axis=0) / solid
+        rows.append([len(rows) + 1, int(sizes[c]), solid, solid / solid_fraction, *(hi - lo), *cen])
+    table = pd.DataFrame(rows, columns=CHIP_COLUMNS)
+    chips_bulk = float(table["bulk_volume_m3"].sum()) if len(table) else 0.0
+    debris_bulk = debris_solid / solid_fraction
+    largest = table.iloc[0] if len(table) else None
+    summary = {
+        "chips_count": int(len(table)),
+        "chips_grains": int(table["n_grains"].sum()) if len(table) else 0,
+        "chips_volume_m3": chips_bulk,
+        "debris_grains": debris_grains,
+        "debris_volume_m3": debris_bulk,
+        "removed_volume_m3": chips_bulk + debris_bulk,
+        "body_grains": int(sizes[body]) if n else 0,
+        "largest_chip_grains": int(largest["n_grains"]) if largest is not None else 0,
+        "largest_chip_volume_m3": float(largest["bulk_volume_m3"]) if largest is not None else 0.0,
+        "largest_chip_extent_x_m": float(largest["extent_x_m"]) if largest is not None else 0.0,
+        "largest_chip_extent_y_m": float(largest["extent_y_m"]) if largest is not None else 0.0,
+        "largest_chip_extent_z_m": float(largest["extent_z_m"]) if largest is not None else 0.0,
+    }
+    return table, summary
+
+
+def cutter_work(ts: pd.DataFrame, spin_rate: float) -> float:
+    """Work the cutter did on the rock [J]: -int(F . v_c) dt - int(T_y * spin_rate) dt (trapezoids)."""
+    t = ts["time_s"].to_numpy(dtype=float)
+    if len(t) < 2:
+        return 0.0
+    power = np.zeros(len(t))
+    for axis in "xyz":
+        v = np.gradient(ts[f"cutter_{axis}_m"].to_numpy(dtype=float), t)
+        power -= ts[f"force_{axis}_N"].to_numpy(dtype=float) * v
+    power -= ts["torque_y_Nm"].to_numpy(dtype=float) * spin_rate
+    return float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t)))
+
+
+def groove_area(profile: np.ndarray, radius: float, depth: float) -> float:
+    """Cross-section [m^2] of the groove a disc of this (rho, a) profile cuts at ``depth``.
+
+    The part of the closed profile polygon with rho >= radius - depth (Sutherland-Hodgman clip against
+    one half-plane, then the shoelace formula).
+    """
+    cut = radius - depth
+    pts = np.asarray(profile, dtype=float)
+    out: list[np.ndarray] = []
+    for k in range(len(pts)):
+        p, q = pts[k], pts[(k + 1) % len(pts)]
+        pin, qin = p[0] >= cut, q[0] >= cut
+        if pin:
+            out.append(p)
+        if pin != qin:
+            s = (cut - p[0]) / (q[0] - p[0])
+            out.append(p + s * (q - p))
+    if len(out) < 3:
+        return 0.0
+    a = np.asarray(out)
+    return float(0.5 * abs(np.dot(a[:, 0], np.roll(a[:, 1], -1)) - np.dot(a[:, 1], np.roll(a[:, 0], -1))))
+
+
+def kinematic_volume(case: dict[str, Any], derived: dict[str, Any]) -> float:
+    """Groove volume [m^3] from the kinematics (NaN for indentation)."""
+    from deckgen.deck import cutter_params
+    from deckgen.geometry import _coerce_params
+    from deckgen.spec import Case
+
+    if case["kinematics"]["mode"] == "indentation":
+        return float("nan")
+    kind, params = cutter_params(Case.model_validate({k: v for k, v in case.items() if k != "test"}))
+    prof = _coerce_params(kind, params).profile()
+    cut = derived["cutter"]
+    length = max(0.0, cut["travel"] - case["kinematics"]["start_clearance_mm"] * 1e-3)
+    return groove_area(prof, cut["radius"], cut["penetration"]) * length
+
+
+def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[str, Any],
+            min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Chips, removed volume, cutter work and specific energies of a cutting run folder."""
+    derived = spec["derived"]
+    bonds = initial_bonds(run_dir)
+    if bonds is None:
+        raise FileNotFoundError(f"{run_dir}: no specimen.data and no step-0 bond sample: initial bonds unknown")
+    atoms = last_frame(run_dir)
+    phi = float(derived["packing"]["solid_fraction"])
+    table, out = find_chips(bonds, broken[["id1", "id2"]].to_numpy(dtype=np.int64), atoms, phi, min_grains)
+    work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)))
+    v_kin = kinematic_volume(spec["case"], derived)
+    out.update({
+        "cutter_work_J": work,
+        "kinematic_volume_m3": v_kin,
+        "specific_energy_chips_J_m3": work / out["removed_volume_m3"] if out["removed_volume_m3"] > 0 else float("nan"),
+        "specific_energy_kinematic_J_m3": work / v_kin if v_kin and math.isfinite(v_kin) and v_kin > 0 else float("nan"),
+    })
+    return table, out

@@ -1,0 +1,119 @@
+"""Chips (connected components of the remaining bond graph) and specific energy."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from deckgen.chips import cutter_work, find_chips, groove_area, kinematic_volume, read_bonds
+from deckgen.geometry import ccs_disc, v_disc
+
+RUNS = Path(__file__).resolve().parent / "data" / "runs"
+
+
+def _atoms(n: int, r: float = 1e-3) -> pd.DataFrame:
+    return pd.DataFrame({"id": np.arange(1, n + 1), "type": 1, "radius": r,
+                         "x": np.arange(n) * 2 * r, "y": 0.0, "z": 0.0})
+
+
+def test_two_triangles_split_into_body_and_chip():
+    # grains 1-3 and 4-6 are triangles joined by the bond 3-4 (plus 7 bonded only to 6)
+    bonds = np.array([[1, 2], [2, 3], [1, 3], [3, 4], [4, 5], [5, 6], [4, 6], [6, 7]])
+    atoms = _atoms(8)  # grain 8 never had a bond: neither chip nor debris
+    table, s = find_chips(bonds, np.array([[4, 3], [7, 6]]), atoms, solid_fraction=0.6, min_grains=3)
+    assert s["chips_count"] == 1 and s["chips_grains"] == 3
+    assert s["body_grains"] == 3
+    assert s["debris_grains"] == 1  # grain 7 lost its only bond
+    v = 4 / 3 * math.pi * 1e-9
+    assert s["chips_volume_m3"] == pytest.approx(3 * v / 0.6)
+    assert s["removed_volume_m3"] == pytest.approx(4 * v / 0.6)
+    # the chip is one of the triangles: 3 grains in a row of 2 mm spacing, 1 mm radius
+    assert table["extent_x_m"].iloc[0] == pytest.approx(6e-3)
+    assert table["extent_z_m"].iloc[0] == pytest.approx(2e-3)
+
+
+def test_nothing_broken_means_no_chips():
+    bonds = np.array([[1, 2], [2, 3]])
+    table, s = find_chips(bonds, np.zeros((0, 2), dtype=int), _atoms(3), 0.6)
+    assert s["chips_count"] == 0 and s["removed_volume_m3"] == 0 and len(table) == 0
+
+
+def test_groove_area_of_a_sharp_v_disc():
+    # a sharp V of included angle 60 deg cuts a triangle: area = p^2 tan(30 deg)
+    R, p = 10e-3, 2e-3
+    prof = v_disc(2 * R, 60.0, 0.0, 8e-3)
+    assert groove_area(prof, R, p) == pytest.approx(p**2 * math.tan(math.radians(30)), rel=1e-6)
+    assert groove_area(prof, R, 0.0) == pytest.approx(0.0, abs=1e-15)
+
+
+def test_groove_area_of_a_ccs_disc_grows_with_tip_width():
+    R, p = 0.2159, 5e-3
+    narrow = groove_area(ccs_disc(2 * R, 12e-3, 0.0 + 1e-4, 10.0, 60e-3), R, p)
+    wide = groove_area(ccs_disc(2 * R, 20e-3, 1e-4, 10.0, 60e-3), R, p)
+    assert wide - narrow == pytest.approx(8e-3 * p, rel=0.02)  # 8 mm wider land over 5 mm depth
+
+
+def test_cutter_work_of_a_constant_force():
+    t = np.linspace(0, 1e-3, 101)
+    ts = pd.DataFrame({"time_s": t, "cutter_x_m": 2.0 * t, "cutter_y_m": 0.0, "cutter_z_m": 0.0,
+                       "force_x_N": -10.0, "force_y_N": 3.0, "force_z_N": 5.0, "torque_y_Nm": -0.5})
+    # translation: -F.v = 10 N * 2 m/s for 1 ms = 0.02 J; spin 100 rad/s against -0.5 N m: 0.05 J
+    assert cutter_work(ts, 0.0) == pytest.approx(0.02)
+    assert cutter_work(ts, 100.0) == pytest.approx(0.02 + 0.05)
+
+
+def test_chips_on_the_committed_reference_cut(tmp_path):
+    """Initial bonds from the step-0 bond sample; every grain is body, chip, debris or intact-unbonded."""
+    from deckgen.chips import initial_bonds
+    from deckgen.results import parse_run
+
+    run = RUNS / "ref_cut"
+    spec = json.loads((run / "spec.json").read_text())
+    bonds = initial_bonds(run)
+    assert len(bonds) == spec["derived"]["n_bonds"]
+    s = parse_run(run, tmp_path / "p")
+    assert s["notes"] == ""
+    assert s["body_grains"] + s["chips_grains"] + s["debris_grains"] <= spec["derived"]["n_grains"]
+    assert s["body_grains"] > 0.5 * spec["derived"]["n_grains"]
+    assert s["cutter_work_J"] > 0
+    assert s["kinematic_volume_m3"] == pytest.approx(kinematic_volume(spec["case"], spec["derived"]), rel=1e-12)
+
+
+@pytest.mark.engine
+def test_chips_of_a_real_cut(tmp_path):
+    """Tiny oscillating cut (golden case, committed packing) run by the engine, then parsed."""
+    import importlib.util
+
+    from deckgen.results import parse_run
+    from deckgen.runner import engine_available, run_deck
+
+    if not engine_available():
+        pytest.skip("no LAMMPS binary (run `make setup`)")
+    golden = Path(__file__).resolve().parent / "data" / "golden"
+    mod_spec = importlib.util.spec_from_file_location("regenerate", golden / "regenerate.py")
+    regen = importlib.util.module_from_spec(mod_spec)
+    mod_spec.loader.exec_module(regen)
+    run = tmp_path / "run"
+    regen.render_golden("tiny_cut", run, tmp_path / "cache")
+    spec = json.loads((run / "spec.json").read_text())
+    run_deck(run, expected_steps=spec["derived"]["expected_steps"], progress=False)
+    s = parse_run(run, tmp_path / "parsed")
+    chips = pd.read_parquet(tmp_path / "parsed" / "chips.parquet")
+    n = spec["derived"]["n_grains"]
+    assert s["bonds_broken"] > 0
+    assert s["chips_count"] == len(chips) and s["chips_grains"] == int(chips["n_grains"].sum())
+    assert (chips["n_grains"] >= 2).all()
+    assert s["body_grains"] + s["chips_grains"] + s["debris_grains"] <= n
+    assert s["body_grains"] > 0.5 * n  # the block stays one piece
+    assert s["removed_volume_m3"] == pytest.approx(s["chips_volume_m3"] + s["debris_volume_m3"])
+    assert s["cutter_work_J"] > 0
+    # kinematic groove of the 60 deg V disc (tip radius 0.3 mm) at 1.5 mm over 3 - 1 mm of cut
+    assert s["kinematic_volume_m3"] == pytest.approx(kinematic_volume(spec["case"], spec["derived"]))
+    assert 0.3 * 1.5e-3**2 * math.tan(math.radians(30)) * 2e-3 < s["kinematic_volume_m3"] < 1.5e-3**2 * 2e-3
+    assert s["specific_energy_kinematic_J_m3"] == pytest.approx(s["cutter_work_J"] / s["kinematic_volume_m3"])
+    assert len(read_bonds(run / "specimen.data")) == spec["derived"]["n_bonds"]

@@ -61,10 +61,13 @@ def test_groove_area_of_a_ccs_disc_grows_with_tip_width():
 def test_cutter_work_of_a_constant_force():
     t = np.linspace(0, 1e-3, 101)
     ts = pd.DataFrame({"time_s": t, "cutter_x_m": 2.0 * t, "cutter_y_m": 0.0, "cutter_z_m": 0.0,
-                       "force_x_N": -10.0, "force_y_N": 3.0, "force_z_N": 5.0, "torque_y_Nm": -0.5})
+                       "force_x_N": -10.0, "force_y_N": 3.0, "force_z_N": 5.0, "torque_y_Nm": -0.5,
+                       "torque_z_Nm": -0.2})
     # translation: -F.v = 10 N * 2 m/s for 1 ms = 0.02 J; spin 100 rad/s against -0.5 N m: 0.05 J
     assert cutter_work(ts, 0.0) == pytest.approx(0.02)
     assert cutter_work(ts, 100.0) == pytest.approx(0.02 + 0.05)
+    # yaw (rotary path) at 10 rad/s against -0.2 N m about z: 0.002 J more
+    assert cutter_work(ts, 100.0, yaw_rate=10.0) == pytest.approx(0.02 + 0.05 + 0.002)
 
 
 def test_chips_on_the_committed_reference_cut(tmp_path):

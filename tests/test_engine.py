@@ -156,3 +156,40 @@ def test_indentation_kinematics_and_contact(tmp_path, cache):
     after = s[cut["V"] * s["time_s"] > gap + 0.5e-3]
     assert len(after) > 5 and after["force_z_N"].max() > 1.0  # the rock pushes the disc up
     assert s["bonds"].iloc[-1] < spec["derived"]["n_bonds"]  # the indentation broke bonds
+
+
+def test_rotary_path_moves_the_shell_rigidly(tmp_path, cache):
+    """Rotary cut: the centre stays on the circle, and every shell sphere ends where the rigid
+    motion (spin about the yawing disc axis, then yaw about the rotary axis) puts it."""
+    from deckgen.parse.dump import iter_frames
+
+    case = load_case(CASES / "tiny_rotary.yaml")
+    out = tmp_path / "rot"
+    spec = render_case(case, out, cache=cache, progress=False)
+    cut = spec["derived"]["cutter"]
+    assert cut["yaw_rate"] == pytest.approx(2.0 / 0.02)
+    run_deck(out, expected_steps=spec["derived"]["expected_steps"], progress=False)
+    s = read_series(out / "series.txt").drop_duplicates("step", keep="last")
+    phi = s["path_angle_rad"].to_numpy()
+    assert np.allclose(phi, cut["yaw_rate"] * s["time_s"], rtol=0, atol=1e-10)  # printed with 10 digits
+    rr = np.hypot(s["cutter_x_m"] - cut["axis_x"], s["cutter_y_m"] - cut["axis_y"])
+    assert np.allclose(rr, 0.02, rtol=0, atol=1e-10)
+    assert s["force_z_N"].max() > 0.1  # it cut
+    # initial shell positions from the data file, final ones from final.dump.gz
+    text = (out / "specimen.data").read_text().split("Atoms # bpm/sphere")[1].split("Bonds")[0]
+    init = {int(p[0]): np.array([float(v) for v in p[5:8]]) for p in (ln.split() for ln in text.strip().splitlines())
+            if p[2] == "2"}
+    final = None
+    for frame in iter_frames(out / "final.dump.gz", ["id", "type", "x", "y", "z"]):
+        final = frame.data
+    final = final[final["type"] == 2]
+    t_end = float(s["time_s"].iloc[-1]) + (spec["derived"]["expected_steps"] - int(s["step"].iloc[-1])) * spec["derived"]["dt_s"]
+    ph, th = cut["yaw_rate"] * t_end, cut["spin_rate"] * t_end
+    c0 = np.array([cut["xc0"], cut["yc0"], cut["zc0"]])
+    A = np.array([cut["axis_x"], cut["axis_y"], cut["zc0"]])
+    Ry = np.array([[np.cos(th), 0, np.sin(th)], [0, 1, 0], [-np.sin(th), 0, np.cos(th)]])
+    Rz = np.array([[np.cos(ph), -np.sin(ph), 0], [np.sin(ph), np.cos(ph), 0], [0, 0, 1]])
+    err = [np.linalg.norm(A + Rz @ ((c0 - A) + Ry @ (init[i] - c0)) - np.array([x, y, z]))
+           for i, x, y, z in final[["id", "x", "y", "z"]].itertuples(index=False)]
+    # write_dump prints 6 significant digits (1e-7 m here); a wrong transform is off by millimetres
+    assert len(err) == len(init) and max(err) < 2e-7

@@ -59,7 +59,7 @@ def test_strict_undefined():
         render("lammps/ucs.lmp.j2", {"version": "0.1.0"})
 
 
-@pytest.mark.parametrize("name", ["tiny_ucs", "tiny_bts", "tiny_cut"])
+@pytest.mark.parametrize("name", ["tiny_ucs", "tiny_bts", "tiny_cut", "tiny_rotary"])
 def test_golden_deck(tmp_path, name):
     """Rendering the tiny case against its committed packing reproduces the committed deck exactly.
 

@@ -145,8 +145,12 @@ def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid
     return table, summary
 
 
-def cutter_work(ts: pd.DataFrame, spin_rate: float) -> float:
-    """Work the cutter did on the rock [J]: -int(F . v_c) dt - int(T_y * spin_rate) dt (trapezoids)."""
+def cutter_work(ts: pd.DataFrame, spin_rate: float, yaw_rate: float = 0.0) -> float:
+    """Work the cutter did on the rock [J]: -int(F . v_c) dt - int(T . Omega) dt (trapezoids).
+
+    Omega = spin_rate about the disc axis (torque_axis_Nm when present, else torque_y_Nm) plus
+    yaw_rate about z (rotary path).
+    """
     t = ts["time_s"].to_numpy(dtype=float)
     if len(t) < 2:
         return 0.0
@@ -154,7 +158,8 @@ def cutter_work(ts: pd.DataFrame, spin_rate: float) -> float:
     for axis in "xyz":
         v = np.gradient(ts[f"cutter_{axis}_m"].to_numpy(dtype=float), t)
         power -= ts[f"force_{axis}_N"].to_numpy(dtype=float) * v
-    power -= ts["torque_y_Nm"].to_numpy(dtype=float) * spin_rate
+    axis_torque = ts["torque_axis_Nm"] if "torque_axis_Nm" in ts else ts["torque_y_Nm"]
+    power -= axis_torque.to_numpy(dtype=float) * spin_rate + ts["torque_z_Nm"].to_numpy(dtype=float) * yaw_rate
     return float(np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t)))
 
 
@@ -206,7 +211,7 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     atoms = last_frame(run_dir)
     phi = float(derived["packing"]["solid_fraction"])
     table, out = find_chips(bonds, broken[["id1", "id2"]].to_numpy(dtype=np.int64), atoms, phi, min_grains)
-    work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)))
+    work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
     out.update({
         "cutter_work_J": work,

@@ -156,8 +156,21 @@ def cutter_path(case: Case, R: float) -> dict[str, float]:
                 f"kinematics.travel_mm: the cutter would leave the block (needs length >= "
                 f"{(travel + 2 * half_chord + clear) / MM:.1f} mm; fix: shorter travel or longer block)")
     spin_rate = {"none": 0.0, "rolling": V / R, "shaft": -w}[k.spin]
-    return dict(xc0=xc0, yc0=yc0, zc0=zc0, V=V, ecc=e, omega=w, spin_rate=spin_rate, duration=duration,
-                travel=travel, penetration=p, radius=R, mode_indent=1.0 if k.mode == "indentation" else 0.0)
+    out = dict(xc0=xc0, yc0=yc0, zc0=zc0, V=V, ecc=e, omega=w, spin_rate=spin_rate, duration=duration,
+               travel=travel, penetration=p, radius=R, mode_indent=1.0 if k.mode == "indentation" else 0.0,
+               yaw_rate=0.0, rotary_radius=0.0, axis_x=0.0, axis_y=0.0)
+    if k.mode == "rotary":
+        r = k.rotary_radius_mm * MM
+        phi_end = travel / r
+        if phi_end > math.pi / 2:
+            raise SpecError(f"kinematics.travel_mm: {k.travel_mm:g} mm is more than a quarter of the rotary path "
+                            f"(radius {k.rotary_radius_mm:g} mm) (fix: shorter travel or larger rotary_radius_mm)")
+        y_end = r * (1.0 - math.cos(phi_end))
+        if y_end + half_chord > W / 2:
+            raise SpecError(f"kinematics.rotary_radius_mm: the curved path drifts {y_end / MM:.1f} mm sideways and leaves "
+                            f"the block (fix: wider block, larger radius or shorter travel)")
+        out.update(yaw_rate=V / r, rotary_radius=r, axis_x=xc0, axis_y=yc0 + r)
+    return out
 
 
 def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progress: bool = True,
@@ -305,6 +318,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         # room for the whole motion
         lo[0] = min(lo[0], path["xc0"] - R - 2 * path["ecc"] - pad)
         hi[0] = max(hi[0], path["xc0"] + (0 if path["mode_indent"] else path["travel"]) + R + 2 * path["ecc"] + pad)
+        if path["rotary_radius"]:
+            hi[1] = max(hi[1], path["rotary_radius"] * (1 - math.cos(path["travel"] / path["rotary_radius"])) + R + pad)
         lo[2] = min(lo[2], -pad)
         hi[2] = max(hi[2], path["zc0"] + R + 2 * path["ecc"] + pad)
         box = np.stack([lo, hi], axis=1)
@@ -325,6 +340,10 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("omega", path["omega"], "oscillation angular frequency", "rad/s"),
             _var("spin_rate", path["spin_rate"], "spin about the disc axis (y)", "rad/s"),
             _var("indent", path["mode_indent"], "1 = push along -z (indentation), 0 = cut along +x", "1"),
+            *([_var("r_rot", path["rotary_radius"], "rotary path radius", "m"),
+               _var("yaw_rate", path["yaw_rate"], "yaw rate of the disc on its circular path (v/r)", "rad/s"),
+               _var("ax_x", path["axis_x"], "rotary axis x", "m"),
+               _var("ax_y", path["axis_y"], "rotary axis y", "m")] if case.kinematics.mode == "rotary" else []),
             _var("nsteps", steps, "steps of the cut", "steps"),
             _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
         ]
@@ -342,6 +361,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                     bb[kk] = (bb[kk, 0] - pad, bb[kk, 1] + pad)
             faces.append({"name": f, "bounds": [float(v) for v in bb.ravel()]})
         ctx["fixed_faces"] = faces
+        ctx["rotary"] = case.kinematics.mode == "rotary"
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),
                         dict(i=2, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut")]

@@ -114,7 +114,7 @@ PLATEN_TIMESERIES_COLUMNS = [
 ]
 CUTTING_TIMESERIES_COLUMNS = [
     "time_s", "step", "cutter_x_m", "cutter_y_m", "cutter_z_m", "force_x_N", "force_y_N",
-    "force_z_N", "torque_x_Nm", "torque_y_Nm", "torque_z_Nm", "spin_angle_rad",
+    "force_z_N", "torque_x_Nm", "torque_y_Nm", "torque_z_Nm", "spin_angle_rad", "path_angle_rad",
     "force_magnitude_N", "force_normal_N", "force_rolling_N", "force_side_N", "torque_axis_Nm",
     "cutter_advance_m", "penetration_m", "bonds_intact", "bonds_broken", "broken_fraction_1",
     "kinetic_energy_J",
@@ -338,12 +338,20 @@ def _cutting_timeseries(raw: pd.DataFrame, path: Path, n0: int, spec: dict[str, 
         ts[dst] = raw[src].astype(float)
     fx, fy, fz = ts["force_x_N"], ts["force_y_N"], ts["force_z_N"]
     ts["force_magnitude_N"] = np.sqrt(fx**2 + fy**2 + fz**2)
+    # disc frame (seed 002's r, s, n): rolling = -F along the path tangent (cos phi, sin phi, 0), side = F
+    # along the disc axis (-sin phi, cos phi, 0) (toward the rotary axis), normal = F_z; phi = 0 unless rotary
+    phi = raw["path_angle_rad"].astype(float) if "path_angle_rad" in raw else pd.Series(0.0, index=raw.index)
+    c, s_ = np.cos(phi), np.sin(phi)
+    ts["path_angle_rad"] = phi.to_numpy()
     ts["force_normal_N"] = fz
-    ts["force_rolling_N"] = -fx
-    ts["force_side_N"] = fy
-    ts["torque_axis_Nm"] = ts["torque_y_Nm"]
+    ts["force_rolling_N"] = -(fx * c + fy * s_)
+    ts["force_side_N"] = -fx * s_ + fy * c
+    ts["torque_axis_Nm"] = -ts["torque_x_Nm"] * s_ + ts["torque_y_Nm"] * c
     cut = spec["derived"].get("cutter", {})
-    ts["cutter_advance_m"] = ts["cutter_x_m"] - float(cut.get("xc0", ts["cutter_x_m"].iloc[0] if len(ts) else 0.0))
+    if float(cut.get("rotary_radius", 0.0) or 0.0) > 0:
+        ts["cutter_advance_m"] = float(cut["rotary_radius"]) * phi  # arc length along the path
+    else:
+        ts["cutter_advance_m"] = ts["cutter_x_m"] - float(cut.get("xc0", ts["cutter_x_m"].iloc[0] if len(ts) else 0.0))
     if spec["derived"].get("kinematics_mode") == "indentation":
         clear = float(spec["case"]["kinematics"]["start_clearance_mm"]) * 1e-3
         zc0 = float(cut.get("zc0", ts["cutter_z_m"].iloc[0] if len(ts) else 0.0))

@@ -201,18 +201,23 @@ class Kinematics(_Model):
     """Cutter motion. x = forward (cut) direction, z = up, disc axis = y.
 
     Centre path: x(t) = x0 + v t + e (cos(w t) - 1), z(t) = z0 + e sin(w t) for mode
-    ``oscillation`` (w = 2 pi f); linear: e = 0; indentation: pushed along -z at ``speed_m_s``.
+    ``oscillation`` (w = 2 pi f); linear: e = 0; indentation: pushed along -z at ``speed_m_s``;
+    rotary: the centre runs at ``speed_m_s`` on a circle of radius r about a vertical axis at
+    (x0, y0 + r), starting along +x, and the disc yaws with the path (its axis stays radial).
     Spin about the disc's own axis: ``none`` (the disc translates), ``rolling`` (spins at v/R:
     pure rolling of the rim on the cut floor), ``shaft`` (oscillation: the disc turns rigidly with
     the eccentric shaft, as in seed 003)."""
 
-    mode: Literal["indentation", "linear", "oscillation"] = _f("linear", "token", "Kinematics family.")
+    mode: Literal["indentation", "linear", "oscillation", "rotary"] = _f("linear", "token", "Kinematics family.")
     speed_m_s: float = _f(1.0, "m/s", "Forward speed (linear/oscillation) or push speed (indentation).", gt=0, le=50)
     penetration_mm: float = _f(2.0, "mm", "Cut depth below the block top (linear/oscillation) or maximum indentation depth.", gt=0)
     travel_mm: float = _f(10.0, "mm", "Forward travel of the cutter (linear/oscillation).", gt=0)
     start_clearance_mm: float = _f(1.0, "mm", "Gap between the cutter and the block at the start.", ge=0)
     edge_distance_mm: float = _f(10.0, "mm", "indentation: cut spacing, distance of the cutting edge from the free y min face.", gt=0)
     eccentricity_mm: float = _f(0.0, "mm", "oscillation: eccentricity e (distance disc centre - rotation axis).", ge=0)
+    rotary_radius_mm: float = _f(
+        250.0, "mm", "rotary: radius r of the circular path (installation radius on a cutterhead, seed 002).", gt=0
+    )
     frequency_hz: float = _f(0.0, "Hz", "oscillation: frequency f (rev/s).", ge=0)
     spin: Literal["none", "rolling", "shaft"] = _f(
         "none", "token", "Spin of the disc about its own axis: none, rolling (v/R) or shaft (with the eccentric shaft)."

@@ -16,7 +16,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 CASES = HERE.parent / "cases"
-NAMES = ["tiny_ucs", "tiny_bts", "tiny_cut"]
+NAMES = ["tiny_ucs", "tiny_bts", "tiny_cut", "tiny_rotary"]
 
 
 def install_fixture(case, name: str, cache: Path) -> None:

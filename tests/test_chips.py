@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from deckgen.chips import cutter_work, find_chips, groove_area, kinematic_volume, read_bonds
+from deckgen.chips import cutter_work, find_chips, groove_area, kinematic_volume
+from deckgen.datafile import read_bonds
 from deckgen.geometry import ccs_disc, v_disc
 
 RUNS = Path(__file__).resolve().parent / "data" / "runs"

@@ -24,36 +24,11 @@ import pandas as pd
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from deckgen.parse.common import ParseError, open_text
+from deckgen.datafile import read_bonds
 from deckgen.parse.dump import iter_frames
 
 CHIP_COLUMNS = ["chip", "n_grains", "solid_volume_m3", "bulk_volume_m3", "extent_x_m", "extent_y_m",
                 "extent_z_m", "centroid_x_m", "centroid_y_m", "centroid_z_m"]
-
-
-def read_bonds(path: str | Path) -> np.ndarray:
-    """Atom-id pairs of the Bonds section of a LAMMPS data file (streamed), as an (n, 2) array."""
-    path = Path(path)
-    pairs: list[tuple[int, int]] = []
-    section = False
-    with open_text(path) as fh:
-        for lineno, raw in enumerate(fh, 1):
-            line = raw.split("#", 1)[0].strip()
-            if not line:
-                continue
-            if not section:
-                section = line == "Bonds"
-                continue
-            if line[0].isalpha():
-                break
-            parts = line.split()
-            if len(parts) != 4:
-                raise ParseError(path, lineno, f"bond line needs 4 columns (id type atom1 atom2), got {len(parts)}")
-            try:
-                pairs.append((int(parts[2]), int(parts[3])))
-            except ValueError:
-                raise ParseError(path, lineno, "non-integer atom id in bond line") from None
-    return np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 def initial_bonds(run_dir: Path) -> np.ndarray | None:

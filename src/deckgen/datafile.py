@@ -33,6 +33,22 @@ class Atoms:
         return len(self.ids)
 
 
+def iter_section(path: Path, name: str):
+    """Yield (line number, fields) of the data-file section ``name`` (e.g. "Atoms", "Bonds"), streamed."""
+    inside = False
+    with open_text(path) as fh:
+        for lineno, raw in enumerate(fh, 1):
+            line = raw.split("#", 1)[0].strip()
+            if not line:
+                continue
+            if not inside:
+                inside = line == name
+                continue
+            if line[0].isalpha():
+                return
+            yield lineno, line.split()
+
+
 def read_sphere_data(path: str | Path) -> Atoms:
     """Read the Atoms section of a data file written by ``write_data`` with atom_style sphere.
 
@@ -41,40 +57,33 @@ def read_sphere_data(path: str | Path) -> Atoms:
     path = Path(path)
     natoms = None
     box = np.zeros((3, 2))
-    rows: list[list[float]] = []
-    section = None
-    with open_text(path) as fh:
-        for lineno, raw in enumerate(fh, 1):
-            line = raw.split("#", 1)[0].strip()
-            if not line:
+    with open_text(path) as fh:  # header, up to the first section (line 1 is a free-text title)
+        next(fh, None)
+        for raw in fh:
+            parts = raw.split("#", 1)[0].split()
+            if not parts:
                 continue
-            if section is None:
-                parts = line.split()
-                if line.endswith(" atoms") and len(parts) == 2:
-                    natoms = int(parts[0])
-                elif len(parts) == 4 and parts[2][1:] == "lo" and parts[3][1:] == "hi":
-                    k = "xyz".index(parts[2][0])
-                    box[k] = (float(parts[0]), float(parts[1]))
-                elif parts[0] == "Atoms":
-                    section = "atoms"
-                continue
-            if section == "atoms":
-                if line[0].isalpha():
-                    break
-                parts = line.split()
-                if len(parts) < 7:
-                    raise ParseError(path, lineno, f"atom line needs 7 columns (id type diameter density x y z), got {len(parts)}")
-                try:
-                    rows.append([float(v) for v in parts[:7]])
-                except ValueError:
-                    raise ParseError(path, lineno, "non-numeric value in atom line") from None
+            if parts[0][0].isalpha():
+                break
+            if len(parts) == 2 and parts[1] == "atoms":
+                natoms = int(parts[0])
+            elif len(parts) == 4 and parts[2][1:] == "lo" and parts[3][1:] == "hi":
+                box["xyz".index(parts[2][0])] = (float(parts[0]), float(parts[1]))
     if natoms is None:
         raise ParseError(path, 1, "no 'N atoms' header line")
+    rows: list[list[float]] = []
+    lineno = 1
+    for lineno, parts in iter_section(path, "Atoms"):
+        if len(parts) < 7:
+            raise ParseError(path, lineno, f"atom line needs 7 columns (id type diameter density x y z), got {len(parts)}")
+        try:
+            rows.append([float(v) for v in parts[:7]])
+        except ValueError:
+            raise ParseError(path, lineno, "non-numeric value in atom line") from None
     if len(rows) != natoms:
         raise ParseError(path, lineno, f"header says {natoms} atoms, Atoms section has {len(rows)}")
     a = np.array(rows)
-    order = np.argsort(a[:, 0])
-    a = a[order]
+    a = a[np.argsort(a[:, 0])]
     return Atoms(
         ids=a[:, 0].astype(np.int64),
         types=a[:, 1].astype(np.int64),
@@ -83,6 +92,20 @@ def read_sphere_data(path: str | Path) -> Atoms:
         x=a[:, 4:7],
         box=box,
     )
+
+
+def read_bonds(path: str | Path) -> np.ndarray:
+    """Atom-id pairs of the Bonds section of a data file (streamed), as an (n, 2) array."""
+    path = Path(path)
+    pairs: list[tuple[int, int]] = []
+    for lineno, parts in iter_section(path, "Bonds"):
+        if len(parts) != 4:
+            raise ParseError(path, lineno, f"bond line needs 4 columns (id type atom1 atom2), got {len(parts)}")
+        try:
+            pairs.append((int(parts[2]), int(parts[3])))
+        except ValueError:
+            raise ParseError(path, lineno, "non-integer atom id in bond line") from None
+    return np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 def write_bpm_data(

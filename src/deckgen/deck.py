@@ -49,6 +49,18 @@ def effective_modulus(E1: float, nu1: float, E2: float, nu2: float, nu_deck: flo
     return 2.0 * (1.0 - nu_deck**2) * e_star
 
 
+def path_variables(path: dict[str, float]) -> list[dict[str, Any]]:
+    """Deck variables of the cutter path (:func:`cutter_path`), shared by the LAMMPS and LIGGGHTS decks."""
+    return [
+        _var("xc0", path["xc0"], "cutter centre start x", "m"),
+        _var("yc0", path["yc0"], "cutter centre start y", "m"),
+        _var("zc0", path["zc0"], "cutter centre start z", "m"),
+        _var("v_cut", path["V"], "forward (or push) speed", "m/s"),
+        _var("ecc", path["ecc"], "eccentricity e", "m"),
+        _var("omega", path["omega"], "oscillation angular frequency", "rad/s"),
+    ]
+
+
 def _round_up(n: int, quantum: int) -> int:
     return -(-int(n) // quantum) * quantum
 
@@ -332,12 +344,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("E_cut", E_rc, "cutter-grain Hertz modulus (steel on rock)", "Pa"),
             _var("mu_cut", c.cutter_friction, "cutter-grain friction", "1"),
             _var("mu_roll_cut", 0.0, "cutter-grain rolling friction", "1"),
-            _var("xc0", path["xc0"], "cutter centre start x", "m"),
-            _var("yc0", path["yc0"], "cutter centre start y", "m"),
-            _var("zc0", path["zc0"], "cutter centre start z", "m"),
-            _var("v_cut", path["V"], "forward (or push) speed", "m/s"),
-            _var("ecc", path["ecc"], "eccentricity e", "m"),
-            _var("omega", path["omega"], "oscillation angular frequency", "rad/s"),
+            *path_variables(path),
             _var("spin_rate", path["spin_rate"], "spin about the disc axis (y)", "rad/s"),
             _var("indent", path["mode_indent"], "1 = push along -z (indentation), 0 = cut along +x", "1"),
             *([_var("r_rot", path["rotary_radius"], "rotary path radius", "m"),

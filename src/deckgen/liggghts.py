@@ -74,6 +74,7 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 
 from deckgen import __version__
+from deckgen.deck import _round_up, _var, path_variables
 from deckgen.runner import EngineError, run_deck, default_ranks
 from deckgen.spec import GPA, MM, MPA, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
 
@@ -329,14 +330,6 @@ def _seeds(seed: int, count: int) -> list[int]:
     return out
 
 
-def _var(name: str, value: float | int, comment: str, unit: str) -> dict[str, Any]:
-    return {"name": name, "value": value, "comment": comment, "unit": unit}
-
-
-def _round_up(n: int, quantum: int) -> int:
-    return -(-int(n) // quantum) * quantum
-
-
 def contact_model(rolling: bool, cohesion: bool) -> list[str]:
     m = ["model", "hertz", "tangential", "history"]
     if cohesion:
@@ -454,12 +447,7 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         _var("fill_fraction", fill_fraction, "insert/pack volume fraction of the fill box", "1"),
         _var("settle_steps", settle_steps, "settling run (3 fall times at g_settle)", "steps"),
         _var("relax_steps", relax_steps, "relaxation runs at 1 g", "steps"),
-        _var("xc0", path["xc0"], "cutter centre start x", "m"),
-        _var("yc0", path["yc0"], "cutter centre start y", "m"),
-        _var("zc0", path["zc0"], "cutter centre start z", "m"),
-        _var("v_cut", path["V"], "forward speed", "m/s"),
-        _var("ecc", path["ecc"], "eccentricity e", "m"),
-        _var("omega", path["omega"], "oscillation angular frequency", "rad/s"),
+        *path_variables(path),
         _var("x_shaft", path["xc0"] - path["ecc"], "eccentric shaft axis x at t = 0", "m"),
         _var("period_osc", 2 * math.pi / path["omega"] if oscillation else 1.0, "oscillation period", "s"),
         _var("spin_rate", path["spin_rate"], "net spin of the disc about +y", "rad/s"),

@@ -89,6 +89,31 @@ def test_tiny_ucs_peak_and_post_peak_breakage(ucs_run):
     mid = pre[(pre.stress_Pa > 0.4 * peak) & (pre.stress_Pa < 0.6 * peak)]
     ratio = (mid.force_bottom_N / -mid.force_top_N).mean()
     assert ratio == pytest.approx(1.0, abs=0.1)
+    # lateral strain of the outer mid-height grains: the cylinder bulges, Poisson's ratio in (0, 0.5)
+    lat = s["lateral_strain"].to_numpy()
+    assert lat[i] > 0 and lat[i] < 0.5 * float(s["strain"].iloc[i])
+    nu = np.polyfit(win["strain"], win["lateral_strain"], 1)[0]
+    assert 0.0 < nu < 0.5, nu
+
+
+def test_tiny_bts_with_curved_jaws(tmp_path, cache):
+    """ISRM jaws: loading starts at contact (no gap), top and bottom jaw forces balance, the disc fails."""
+    case = load_case(CASES / "tiny_bts.yaml")
+    assert case.specimen.loading == "jaws"
+    out = tmp_path / "bts"
+    spec = render_case(case, out, cache=cache, progress=False)
+    jaws = spec["derived"]["jaws"]
+    assert jaws["R_jaw"] == pytest.approx(1.5 * 5e-3)
+    run_deck(out, expected_steps=spec["derived"]["expected_steps"], progress=False)
+    s = read_series(out / "series.txt")
+    assert (s["force_top_N"].iloc[1:4] < 0).all()  # in contact from the first rows: no gap at the start
+    i = int(s["stress_Pa"].idxmax())
+    peak = float(s["stress_Pa"].iloc[i])
+    assert 0.5e6 < peak < 50e6, peak
+    pre = s.iloc[: i + 1]
+    mid = pre[(pre.stress_Pa > 0.3 * peak) & (pre.stress_Pa < 0.6 * peak)]
+    assert (mid.force_bottom_N / -mid.force_top_N).mean() == pytest.approx(1.0, abs=0.15)
+    assert float(s["bonds"].iloc[-1]) < float(s["bonds"].iloc[i])
 
 
 def test_unloaded_specimen_keeps_all_bonds(ucs_run, tmp_path):

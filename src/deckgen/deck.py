@@ -185,6 +185,28 @@ def cutter_path(case: Case, R: float) -> dict[str, float]:
     return out
 
 
+def jaw_positions(x: np.ndarray, r: np.ndarray, R: float, ratio: float) -> dict[str, float]:
+    """Axes of the two curved Brazilian jaws (axis y, radius ``ratio * R``) touching the extreme grains.
+
+    The disc (axis y) lies inside both jaw cylinders; the bottom jaw's axis sits above the disc centre
+    and its arc touches the lowest grain, the top jaw's axis sits below and its arc touches the highest
+    grain, so loading starts at t = 0 without a gap or an initial overlap (to 1e-12 m).
+    """
+    from scipy.optimize import brentq
+
+    R_jaw = ratio * R
+    xc = 0.5 * (float((x[:, 0] - r).min()) + float((x[:, 0] + r).max()))
+    zc = 0.5 * (float((x[:, 2] - r).min()) + float((x[:, 2] + r).max()))
+
+    def reach(z: float) -> float:  # > 0 when some grain sticks out of the jaw cylinder with axis at z
+        return float((np.hypot(x[:, 0] - xc, x[:, 2] - z) + r).max()) - R_jaw
+
+    d = R_jaw - R
+    zc_top = brentq(reach, zc - d - 0.5 * R, zc - d + 0.5 * R, xtol=1e-13)
+    zc_bot = brentq(reach, zc + d - 0.5 * R, zc + d + 0.5 * R, xtol=1e-13)
+    return {"R_jaw": R_jaw, "x": xc, "zc_top": float(zc_top), "zc_bot": float(zc_bot)}
+
+
 def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progress: bool = True,
                 command: list[str] | None = None) -> dict[str, Any]:
     """Render the run folder ``out`` for ``case`` (packing it first if needed). Returns spec.json content."""
@@ -245,6 +267,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         "version": __version__, "case_name": case.name, "test": case.test, "deck_name": DECK,
         "data_file": DATA, "integrate_group": "rock", "pair_coeffs": pair_coeffs,
         "bond_coeffs": table.coeff_rows(), "bond_state_every": case.outputs.bond_state_every,
+        "jaws": False,
     }
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
@@ -275,6 +298,25 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         z_bot = float((atoms.x[:, 2] - r).min())
         z_top = float((atoms.x[:, 2] + r).max())
         height = z_top - z_bot
+        if isinstance(sp, BrazilianDisc) and sp.loading == "jaws":
+            jaws = jaw_positions(atoms.x, r, sp.diameter_mm * MM / 2.0, sp.jaw_radius_ratio)
+            ctx["jaws"] = True
+            variables += [
+                _var("R_jaw", jaws["R_jaw"], "jaw radius (jaw_radius_ratio x disc radius)", "m"),
+                _var("jaw_x", jaws["x"], "jaw axes: x (disc centre)", "m"),
+                _var("zc_bot", jaws["zc_bot"], "bottom jaw axis z (its arc touches the lowest grain)", "m"),
+                _var("zc_top", jaws["zc_top"], "top jaw axis z at the start (its arc touches the highest grain)", "m"),
+            ]
+            derived["jaws"] = jaws
+        if isinstance(sp, UcsCylinder):
+            # lateral strain: mean radial displacement of the outer grains of the middle third / R
+            R_s = sp.diameter_mm * MM / 2.0
+            variables += [
+                _var("R_spec", R_s, "cylinder radius (lateral strain = mean radial displacement / R)", "m"),
+                _var("r_skin_in", R_s - 2.0 * r_max, "outer grains for the lateral strain: centre beyond this radius", "m"),
+                _var("z_mid_lo", z_bot + height / 3.0, "middle third of the height: from", "m"),
+                _var("z_mid_hi", z_top - height / 3.0, "middle third of the height: to", "m"),
+            ]
         v = sp.platen_speed_m_s
         # stop check every ~0.01 % strain, on a multiple of the output intervals so nothing is lost
         chunk = _round_up(max(100, int(1e-4 * height / v / dt)), quantum)

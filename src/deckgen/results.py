@@ -111,6 +111,7 @@ def has_unit(name: str) -> bool:
 PLATEN_TIMESERIES_COLUMNS = [
     "time_s", "step", "platen_displacement_m", "force_top_N", "force_bottom_N", "stress_Pa",
     "strain_1", "bonds_intact", "bonds_broken", "broken_fraction_1", "kinetic_energy_J",
+    "lateral_strain_1",
 ]
 CUTTING_TIMESERIES_COLUMNS = [
     "time_s", "step", "cutter_x_m", "cutter_y_m", "cutter_z_m", "force_x_N", "force_y_N",
@@ -142,7 +143,7 @@ PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
     "bonds_broken_at_peak", "youngs_modulus_Pa", "secant_modulus_Pa", "modulus_fit_points",
     "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa", "modulus_fit_stress_hi_Pa",
-    "final_strain_1", "area_m2", "height_m", "platen_speed_m_s",
+    "final_strain_1", "area_m2", "height_m", "platen_speed_m_s", "poisson_ratio_1",
 ]
 CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "peak")
@@ -326,6 +327,8 @@ def _platen_timeseries(raw: pd.DataFrame, path: Path, n0: int) -> pd.DataFrame:
     ts["bonds_intact"] = np.rint(raw["bonds"].astype(float)).astype(np.int64)
     ts["bonds_broken"] = n0 - ts["bonds_intact"]
     ts["broken_fraction_1"] = ts["bonds_broken"] / n0 if n0 else _nan()
+    # UCS decks print the lateral strain (mean radial displacement of the outer mid-height grains / R)
+    ts["lateral_strain_1"] = raw["lateral_strain"].astype(float) if "lateral_strain" in raw else _nan()
     return ts[PLATEN_TIMESERIES_COLUMNS]
 
 
@@ -550,7 +553,7 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         out.update({k: _nan() for k in ("peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
                                          "bonds_broken_at_peak", modulus_key, "modulus_fit_points",
                                          "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa",
-                                         "modulus_fit_stress_hi_Pa", "final_strain_1")})
+                                         "modulus_fit_stress_hi_Pa", "final_strain_1", "poisson_ratio_1")})
         return out
     stress = ts["stress_Pa"].to_numpy()
     strain = ts["strain_1"].to_numpy()
@@ -565,6 +568,12 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         xm, ym = x.mean(), y.mean()
         slope = float(((x - xm) * (y - ym)).sum() / ((x - xm) ** 2).sum())
         intercept = float(ym - slope * xm)
+    # Poisson's ratio: -d(lateral strain)/d(axial strain) over the same pre-peak window (UCS only)
+    nu = _nan()
+    lat = ts["lateral_strain_1"].to_numpy(dtype=float) if "lateral_strain_1" in ts else np.full(len(ts), np.nan)
+    if test == "ucs" and sel.sum() >= 2 and np.ptp(strain[sel]) > 0 and np.isfinite(lat[sel]).all():
+        nu = float(np.polyfit(strain[sel], lat[sel], 1)[0])  # compression-positive axial, expansion-positive lateral
+    out["poisson_ratio_1"] = nu
     out.update({
         "peak_stress_Pa": peak, "strain_at_peak_1": float(strain[ip]),
         "time_at_peak_s": float(ts["time_s"].iloc[ip]), "peak_force_N": float(-ts["force_top_N"].iloc[ip]),

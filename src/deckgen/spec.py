@@ -141,9 +141,14 @@ class UcsCylinder(_Model):
 
 
 class BrazilianDisc(_Model):
-    """Brazilian test: disc, axis y, loaded across its diameter in z by flat platens."""
+    """Brazilian test: disc, axis y, loaded across its diameter in z, by curved jaws (ISRM) or flat platens."""
 
     kind: Literal["brazilian_disc"] = "brazilian_disc"
+    loading: Literal["jaws", "flat"] = _f(
+        "jaws", "token",
+        "Load introduction: 'jaws' = curved steel jaws of radius jaw_radius_ratio * R (ISRM 1978 suggested method; "
+        "the load spreads over an arc of ~10-15 deg), 'flat' = flat platens (the disc seats on one or two grains).")
+    jaw_radius_ratio: float = _f(1.5, "1", "jaws: jaw radius / disc radius (ISRM: 1.5).", gt=1.0, le=10)
     diameter_mm: float = _f(20.0, "mm", "Disc diameter.", gt=0)
     thickness_mm: float = _f(10.0, "mm", "Disc thickness (t/D = 0.5 is the ISRM shape).", gt=0)
     platen_speed_m_s: float = _f(0.05, "m/s", "Top platen speed.", gt=0, le=10)

@@ -1,0 +1,264 @@
+"""Studies around the calibration (issue #3), each a real DEM measurement with its own table.
+
+``python -m deckgen.calibration_studies <study> ...``:
+
+- ``ratio``: how the bond shear/tensile strength ratio, contact friction, rolling friction and the
+  bond radius multiplier move UCS, BTS, E and UCS/BTS (one UCS + one BTS test per variant).
+- ``quasistatic``: a material card's calibrated point at its platen speeds and at half of them; the
+  change of the peak stresses says whether the loading is quasi-static (issue #3 asks < 3 %).
+- ``seeds``: a calibrated card re-run on new packing seeds: mean, standard deviation and coefficient
+  of variation of UCS, BTS and E.
+- ``table``: the per-rock results table (markdown) from the calibrated cards and the seed studies.
+
+Every study writes ``<out>/<study>.csv`` (one row per virtual test pair) and ``<out>/<study>.md``; the
+engine runs live under ``<out>/work/`` and are answered from disk when repeated (like the calibration).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import shlex
+import sys
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from deckgen.calibrate import (
+    COARSE_PACKING,
+    DEFAULT_BTS,
+    DEFAULT_UCS,
+    GPA,
+    MPA,
+    CardError,
+    DemEvaluator,
+    MicroParams,
+    load_card,
+    quasi_static_specimens,
+)
+from deckgen.spec import SpecError, deep_merge
+
+#: Variants of the ratio study, relative to the base point (E_b 40 GPa, sigma_c 30 MPa).
+RATIO_VARIANTS: list[tuple[str, dict[str, float]]] = [
+    ("tau/sigma=1", {"shear_strength_MPa": 30.0}),
+    ("tau/sigma=2 (base)", {}),
+    ("tau/sigma=1, interaction range gap 0.4 r", {"shear_strength_MPa": 30.0, "gap_tolerance": 0.4}),
+    ("tau/sigma=1, interaction range gap 0.8 r", {"shear_strength_MPa": 30.0, "gap_tolerance": 0.8}),
+    ("tau/sigma=0.5", {"shear_strength_MPa": 15.0}),
+    ("tau/sigma=1, friction 1.0", {"shear_strength_MPa": 30.0, "friction": 1.0}),
+    ("tau/sigma=1, radius multiplier 0.6", {"shear_strength_MPa": 30.0, "radius_multiplier": 0.6}),
+    ("tau/sigma=1, interaction range gap 0.6 r", {"shear_strength_MPa": 30.0, "gap_tolerance": 0.6}),
+]
+
+
+def _summaries(ev: DemEvaluator, p: MicroParams) -> tuple[dict[str, Any], dict[str, Any]]:
+    folder = ev.folder(p)
+    return (json.loads((folder / "ucs" / "parsed" / "summary.json").read_text()),
+            json.loads((folder / "bts" / "parsed" / "summary.json").read_text()))
+
+
+def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
+    r = ev.evaluate(p)
+    row: dict[str, Any] = {"variant": label, **asdict(p), "ok": r["ok"], "error": r["error"],
+                           "ucs_Pa": r["ucs_Pa"], "bts_Pa": r["bts_Pa"], "E_Pa": r["E_Pa"],
+                           "ucs_to_bts_1": r["ucs_Pa"] / r["bts_Pa"] if r["ok"] else math.nan,
+                           "wall_s": r.get("wall_s", math.nan)}
+    if r["ok"]:
+        u, b = _summaries(ev, p)
+        row.update({
+            "poisson_ratio_1": u.get("poisson_ratio_1", math.nan),
+            "ucs_strain_at_peak_1": u.get("strain_at_peak_1"), "bts_strain_at_peak_1": b.get("strain_at_peak_1"),
+            "ucs_broken_tension": u.get("bonds_broken_tension"), "ucs_broken_shear": u.get("bonds_broken_shear"),
+            "bts_broken_tension": b.get("bonds_broken_tension"), "bts_broken_shear": b.get("bonds_broken_shear"),
+            "ucs_grains": u.get("n_grains"), "bts_grains": b.get("n_grains"),
+            "ucs_steps": u.get("steps"), "bts_steps": b.get("steps"),
+        })
+    return row
+
+
+def _write(rows: list[dict[str, Any]], out: Path, name: str, title: str, cols: list[str]) -> pd.DataFrame:
+    out.mkdir(parents=True, exist_ok=True)
+    df = pd.DataFrame(rows)
+    df.to_csv(out / f"{name}.csv", index=False)
+    show = df[[c for c in cols if c in df]].copy()
+    for c in show:
+        if c.endswith("_Pa"):
+            show[c.replace("_Pa", "_MPa")] = show.pop(c) / MPA
+        if c == "E_Pa":
+            show["E_GPa"] = show.pop("E_MPa") / 1e3
+    (out / f"{name}.md").write_text(f"# {title}\n\n" + show.to_markdown(index=False, floatfmt=".4g") + "\n")
+    return df
+
+
+def ratio_study(out: Path, *, base: dict[str, Any] | None = None, ucs: dict[str, Any] | None = None,
+                bts: dict[str, Any] | None = None, cache: Path | None = None,
+                command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
+    """One UCS + BTS pair per variant of :data:`RATIO_VARIANTS` (calibration specimens, coarse grains, 0.1 m/s)."""
+    base = base or {"material": {"density_kg_m3": 2650}, "packing": dict(COARSE_PACKING)}
+    ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}
+    bts = bts or {**DEFAULT_BTS, "platen_speed_m_s": 0.1}
+    ev = DemEvaluator(base, ucs, bts, out / "work", cache=cache, command=command, name="ratio", parallel=parallel)
+    p0 = MicroParams(youngs_modulus_GPa=40.0, tensile_strength_MPa=30.0, shear_strength_MPa=60.0)
+    rows = []
+    for label, change in RATIO_VARIANTS:
+        rows.append(_row(label, ev, replace(p0, **change)))
+        print(f"ratio: {label}: UCS/BTS {rows[-1]['ucs_to_bts_1']:.3g}", flush=True)
+    return _write(rows, out, "ratio", "UCS/BTS mechanisms (deckgen.calibration_studies ratio)",
+                  ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_to_bts_1", "poisson_ratio_1",
+                   "bts_broken_tension", "bts_broken_shear", "ucs_broken_tension", "ucs_broken_shear"])
+
+
+def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict[str, Any], dict[str, Any]]:
+    card = load_card(card_path)
+    if card.calibrated is None:
+        raise CardError(f"{card_path}: calibrated: missing (fix: run python -m deckgen.calibrate on it first)")
+    b, c = card.calibrated.bonds, card.calibrated.contact
+    p = MicroParams(youngs_modulus_GPa=b["youngs_modulus_GPa"], tensile_strength_MPa=b["tensile_strength_MPa"],
+                    shear_strength_MPa=b["shear_strength_MPa"], friction=c.get("friction", 0.5),
+                    rolling_friction=c.get("rolling_friction", 0.1), radius_multiplier=b.get("radius_multiplier", 1.0))
+    ucs, bts = quasi_static_specimens(card)
+    return card, p, card.case_overrides(), ucs, bts
+
+
+def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
+                      command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
+    """The calibrated point at the card's platen speeds and at half of them."""
+    card, p, base, ucs, bts = _card_setup(card_path)
+    rows = []
+    for factor in (1.0, 0.5):
+        u = {**ucs, "platen_speed_m_s": ucs["platen_speed_m_s"] * factor}
+        b = {**bts, "platen_speed_m_s": bts["platen_speed_m_s"] * factor}
+        ev = DemEvaluator(base, u, b, out / "work" / f"speed_{factor:g}", cache=cache, command=command, name=card.rock, parallel=parallel)
+        row = _row(f"speed x{factor:g}", ev, p)
+        row.update({"rock": card.rock, "speed_factor": factor, "ucs_speed_m_s": u["platen_speed_m_s"],
+                    "bts_speed_m_s": b["platen_speed_m_s"]})
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    for k in ("ucs_Pa", "bts_Pa", "E_Pa"):
+        df[f"{k.removesuffix('_Pa')}_change_at_half_speed_1"] = df[k] / df[k].iloc[0] - 1.0
+    return _write(df.to_dict("records"), out, f"quasistatic_{card.rock}",
+                  f"Quasi-static check, {card.rock} (deckgen.calibration_studies quasistatic)",
+                  ["variant", "ucs_speed_m_s", "bts_speed_m_s", "ucs_Pa", "bts_Pa", "E_Pa",
+                   "ucs_change_at_half_speed_1", "bts_change_at_half_speed_1", "E_change_at_half_speed_1"])
+
+
+def seeds_study(card_path: Path, out: Path, seeds: list[int], *, cache: Path | None = None,
+                command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
+    """The calibrated point on new packing seeds (one UCS + one BTS packing per seed)."""
+    card, p, base, ucs, bts = _card_setup(card_path)
+    rows = []
+    for seed in seeds:
+        b = deep_merge(base, {"packing": {"seed": int(seed)}})
+        ev = DemEvaluator(b, ucs, bts, out / "work" / f"seed_{seed}", cache=cache, command=command, name=card.rock, parallel=parallel)
+        row = _row(f"seed {seed}", ev, p)
+        row.update({"rock": card.rock, "packing_seed": seed})
+        rows.append(row)
+        print(f"seeds {card.rock}: seed {seed}: UCS {row['ucs_Pa'] / MPA:.4g} MPa, BTS {row['bts_Pa'] / MPA:.4g} MPa, "
+              f"E {row['E_Pa'] / GPA:.4g} GPa", flush=True)
+    return _write(rows, out, f"seeds_{card.rock}", f"Packing-seed scatter, {card.rock} (deckgen.calibration_studies seeds)",
+                  ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "poisson_ratio_1", "ucs_grains", "bts_grains"])
+
+
+def scatter(df: pd.DataFrame) -> dict[str, float]:
+    """Mean, standard deviation (ddof 1) and coefficient of variation of UCS, BTS and E over the ok rows."""
+    ok = df[df["ok"].astype(bool)]
+    out: dict[str, float] = {"n": float(len(ok))}
+    for k in ("ucs_Pa", "bts_Pa", "E_Pa"):
+        v = ok[k].to_numpy(dtype=float)
+        m, s = float(np.mean(v)) if len(v) else math.nan, float(np.std(v, ddof=1)) if len(v) > 1 else math.nan
+        out.update({f"{k}_mean": m, f"{k}_std": s, f"{k}_cv": s / m if m else math.nan})
+    return out
+
+
+def results_table(cards: list[Path], studies: Path) -> str:
+    """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
+    head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
+            "| E_b GPa | σ_c MPa | τ_c/σ_c | seeds: UCS, BTS, E mean ± sd (CV) | half speed: ΔUCS, ΔBTS |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    lines = []
+    for path in cards:
+        try:
+            card = load_card(path)
+        except CardError as exc:
+            lines.append(f"| {path} | {exc} |")
+            continue
+        p = card.provenance
+        if p is None or card.calibrated is None:
+            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | |")
+            continue
+        a, b = p.achieved, card.calibrated.bonds
+        nu = "–"
+        sfile = studies / f"seeds_{card.rock}.csv"
+        seeds = "–"
+        if sfile.is_file():
+            s = scatter(pd.read_csv(sfile))
+            seeds = (f"{s['ucs_Pa_mean'] / MPA:.3g} ± {s['ucs_Pa_std'] / MPA:.2g} ({s['ucs_Pa_cv']:.1%}), "
+                     f"{s['bts_Pa_mean'] / MPA:.3g} ± {s['bts_Pa_std'] / MPA:.2g} ({s['bts_Pa_cv']:.1%}), "
+                     f"{s['E_Pa_mean'] / GPA:.3g} ± {s['E_Pa_std'] / GPA:.2g} ({s['E_Pa_cv']:.1%}); n = {s['n']:.0f}")
+            sd = pd.read_csv(sfile)
+            if "poisson_ratio_1" in sd:
+                nu = f"{sd['poisson_ratio_1'].mean():.2f}"
+        qfile = studies / f"quasistatic_{card.rock}.csv"
+        qs = "–"
+        if qfile.is_file():
+            q = pd.read_csv(qfile)
+            if len(q) == 2:
+                qs = f"{q['ucs_change_at_half_speed_1'].iloc[1]:+.1%}, {q['bts_change_at_half_speed_1'].iloc[1]:+.1%}"
+        lines.append(
+            f"| {card.rock} | {a.ucs_MPa:.4g} ({a.ucs_error:+.1%}) | {a.bts_MPa:.4g} ({a.bts_error:+.1%}) | "
+            f"{a.youngs_modulus_GPa:.4g} ({a.youngs_modulus_error:+.1%}) | {nu} | {a.ucs_MPa / a.bts_MPa:.3g} | "
+            f"{p.evaluations}{'' if p.converged else ' (not converged)'} | {p.wall_s / 60:.1f} | "
+            f"{b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
+            f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {seeds} | {qs} |")
+    return head + "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    from deckgen.runner import engine_command
+
+    ap = argparse.ArgumentParser(prog="python -m deckgen.calibration_studies", description=__doc__.split("\n\n")[0])
+    ap.add_argument("study", choices=["ratio", "quasistatic", "seeds", "table"])
+    ap.add_argument("cards", nargs="*", help="calibrated material cards (quasistatic, seeds, table)")
+    ap.add_argument("--out", default="results/calibration/studies", help="output folder")
+    ap.add_argument("--cache", default=None, help="packing cache")
+    ap.add_argument("--seeds", default="101,202,303,404,505", help="seeds study: comma-separated packing seeds")
+    ap.add_argument("--ranks", type=int, default=None, help="MPI ranks per engine run")
+    ap.add_argument("--engine-cmd", default=None, help="engine command line")
+    ap.add_argument("--jobs", type=int, choices=[1, 2], default=1,
+                    help="2: run the UCS and BTS tests of a point at the same time (1 rank each unless --ranks)")
+    ap.add_argument("--write", default=None, help="table: also write the markdown here")
+    a = ap.parse_args(argv)
+    ranks = a.ranks or (1 if a.jobs == 2 else None)
+    command = shlex.split(a.engine_cmd) if a.engine_cmd else (engine_command(ranks) if ranks else None)
+    par = a.jobs == 2
+    out, cache = Path(a.out), (Path(a.cache) if a.cache else None)
+    try:
+        if a.study == "ratio":
+            print(ratio_study(out, cache=cache, command=command, parallel=par).to_string())
+        elif a.study == "table":
+            text = results_table([Path(c) for c in a.cards], out)
+            print(text)
+            if a.write:
+                Path(a.write).write_text(text)
+        else:
+            if not a.cards:
+                ap.error(f"{a.study}: give at least one calibrated card")
+            for c in a.cards:
+                if a.study == "quasistatic":
+                    print(quasistatic_study(Path(c), out, cache=cache, command=command, parallel=par).to_string())
+                else:
+                    seeds = [int(s) for s in a.seeds.split(",") if s.strip()]
+                    df = seeds_study(Path(c), out, seeds, cache=cache, command=command, parallel=par)
+                    print(json.dumps(scatter(df), indent=1))
+    except (CardError, SpecError, ValueError) as exc:
+        print(str(exc), file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -101,6 +101,8 @@ def test_analytic_start_reproduces_the_measured_points():
     from deckgen.calibrate import MICRO_MACRO, CardTargets
 
     for g, r, cE, cU, cB in MICRO_MACRO:
+        if g > 0.4:  # the falling branch of UCS/BTS(g): the start takes the rising one
+            continue
         t = CardTargets(density_kg_m3=2650, ucs_MPa=30 * cU, bts_MPa=30 * cB, youngs_modulus_GPa=40 * cE,
                         poisson_ratio=0.25, citation="calibration_studies ratio")
         names = ["log_E_b", "log_sigma_c", "log_tau_ratio"] if g == 0.05 else ["log_E_b", "log_sigma_c", "gap_tolerance"]
@@ -114,8 +116,9 @@ def test_analytic_start_uses_the_interaction_range_for_high_ratios():
     g = analytic_start(_card("colorado_red_granite").targets, None,
                        ParameterSpace(["log_E_b", "log_sigma_c", "gap_tolerance", "log_tau_ratio"]))
     c = analytic_start(_card("concrete").targets, None, ParameterSpace(["log_E_b", "log_sigma_c", "gap_tolerance"]))
-    # UCS/BTS 23 (granite) needs the widest start range and a lower shear ratio; 10 (concrete) a moderate range
-    assert g.gap_tolerance == pytest.approx(0.6) and g.tau_ratio < 1.0
+    # UCS/BTS 23 (granite): the range of the highest measured ratio (g 0.4) and a lower shear ratio;
+    # 10 (concrete): a moderate range
+    assert 0.35 <= g.gap_tolerance <= 0.45 and g.tau_ratio < 0.5
     assert 0.2 < c.gap_tolerance < 0.45 and c.tau_ratio == 1.0
 
 
@@ -154,11 +157,11 @@ def test_converges_on_stand_in(tmp_path, rock):
 
 @pytest.mark.parametrize("rock", ROCKS)
 def test_survives_injected_failures(tmp_path, rock):
-    """20 % of points fail (lost atoms), plus an unstable region; tighter tolerance, so the search is longer."""
+    """30 % of points fail (lost atoms); tighter tolerance, so the search is longer."""
     card = _card(rock)
     fails = 0
-    for seed in ("a", "b", "c"):
-        ev = StandInEvaluator(noise=0.005, fail_rate=0.2, seed=seed)
+    for seed in ("a", "b", "c", "d"):
+        ev = StandInEvaluator(noise=0.005, fail_rate=0.3, seed=seed)
         res = calibrate(ev, card.targets, analytic_start(card.targets), tmp_path / f"{seed}.csv", tol=0.02,
                         max_evals=30)
         assert res.converged, (seed, res.errors, [e.error for e in res.evaluations])

@@ -382,11 +382,13 @@ MICRO_MACRO = (
     (0.05, 0.5, 7.14 / 40, 7.000 / 30, 0.856 / 30),
     (0.05, 1.0, 8.79 / 40, 13.21 / 30, 2.074 / 30),
     (0.05, 2.0, 9.65 / 40, 18.53 / 30, 3.592 / 30),
-    (0.40, 1.0, 13.0 / 40, 27.47 / 30, 2.256 / 30),
+    (0.40, 1.0, 12.95 / 40, 27.47 / 30, 2.256 / 30),
+    (0.60, 1.0, 14.88 / 40, 37.12 / 30, 3.474 / 30),
+    (0.80, 1.0, 15.78 / 40, 42.55 / 30, 7.359 / 30),
 )
-#: The interaction range the analytic start may choose (the ratio's rise with g is measured up to 0.4;
-#: at g = 0.8 one specimen pair gave a lower UCS/BTS of 5.8, so the start stays below 0.6).
-GAP_START_MAX = 0.6
+#: The interaction range the analytic start may choose. UCS/BTS rises from 6.4 (g 0.05) to 12.2
+#: (g 0.4) and falls again (10.7 at 0.6, 5.8 at 0.8: BTS grows faster once second neighbours bond).
+GAP_START_MAX = 0.8
 #: tau_c/sigma_c of the start when gap_tolerance is a parameter (PFC-style equal strengths).
 TAU_RATIO_START = 1.0
 
@@ -450,8 +452,10 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         return math.exp(brentq(f, lo, hi, xtol=1e-9))
 
     if "gap_tolerance" in sp.names:
-        grid = np.linspace(0.0, GAP_START_MAX, 121)
-        g = float(grid[np.argmin([abs(log_ratio(x, TAU_RATIO_START) - want) for x in grid])])
+        grid = np.linspace(0.0, GAP_START_MAX, 161)
+        lr = np.array([log_ratio(x, TAU_RATIO_START) for x in grid])
+        rising = grid[: int(np.argmax(lr)) + 1]  # the rising branch: the fewest extra bonds for the ratio
+        g = float(rising[np.argmin(np.abs(lr[: len(rising)] - want))])
         r = solve_r(g) if "log_tau_ratio" in sp.names else TAU_RATIO_START
     else:
         g = base.bonds.gap_tolerance
@@ -471,7 +475,7 @@ def prior_jacobian(space: ParameterSpace) -> np.ndarray:
     """d log(UCS, BTS, E) / d x of the measured micro-macro table (rows: outputs; columns: parameters),
     as secants over the measured range (tau_c/sigma_c 0.5-2 at g = 0.05; g 0.05-0.4 at r = 1)."""
     (E1, U1, B1), (E2, U2, B2) = micro_macro(0.05, 0.5), micro_macro(0.05, 2.0)
-    (Eg0, Ug0, Bg0), (Eg1, Ug1, Bg1) = micro_macro(0.05, 1.0), micro_macro(0.4, 1.0)
+    (Eg0, Ug0, Bg0), (Eg1, Ug1, Bg1) = micro_macro(0.05, 1.0), micro_macro(0.4, 1.0)  # the rising branch
     lr = math.log(4.0)
     cols = {
         "log_E_b": [0.0, 0.0, 1.0],

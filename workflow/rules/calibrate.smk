@@ -7,6 +7,18 @@
 wildcard_constraints:
     rock="[a-z][a-z0-9_]*",
 
+#: the rocks of issue #3 (cases/materials/<rock>.yaml)
+CAL_ROCKS = ["savonniere_limestone", "concrete", "sandstone", "colorado_red_granite"]
+CAL_STUDIES = f"{RESULTS}/calibration/studies"
+
+
+def calib_engine_args():
+    """UCS and BTS of a point side by side on half the ranks each (1-rank runs share 2 cores best)."""
+    if config.get("engine_cmd"):
+        return engine_args()
+    ranks = int(config.get("ranks", 2))
+    return f"--jobs 2 --ranks {max(1, ranks // 2)}" if ranks >= 2 else "--ranks 1"
+
 
 rule calibrate:
     input:
@@ -20,10 +32,67 @@ rule calibrate:
     benchmark:
         f"{RESULTS}/benchmarks/calibrate/{{rock}}.tsv"
     threads: config.get("ranks", 2)
+    priority: 10
     params:
         out=lambda w, output: str(Path(output.card).parent),
         cache=f"{RESULTS}/.cache",
-        engine=engine_args(),
+        engine=calib_engine_args(),
     shell:
         "python -m deckgen.calibrate {input.targets} --out {params.out} --cache {params.cache} "
         "{params.engine} > {log} 2>&1"
+
+
+# packing-seed scatter of a calibrated card: 5 new packings (one UCS + one BTS each)
+rule calibration_seeds:
+    input:
+        card=f"{RESULTS}/calibration/{{rock}}/card.yaml",
+    output:
+        f"{CAL_STUDIES}/seeds_{{rock}}.csv",
+    log:
+        f"{RESULTS}/logs/calibration_seeds/{{rock}}.log",
+    threads: config.get("ranks", 2)
+    params:
+        out=CAL_STUDIES,
+        cache=f"{RESULTS}/.cache",
+        engine=calib_engine_args(),
+    shell:
+        "python -m deckgen.calibration_studies seeds {input.card} --out {params.out} --cache {params.cache} "
+        "{params.engine} > {log} 2>&1"
+
+
+# quasi-static check: the calibrated point again at half the platen speeds
+rule calibration_quasistatic:
+    input:
+        card=f"{RESULTS}/calibration/{{rock}}/card.yaml",
+    output:
+        f"{CAL_STUDIES}/quasistatic_{{rock}}.csv",
+    log:
+        f"{RESULTS}/logs/calibration_quasistatic/{{rock}}.log",
+    threads: config.get("ranks", 2)
+    priority: 5
+    params:
+        out=CAL_STUDIES,
+        cache=f"{RESULTS}/.cache",
+        engine=calib_engine_args(),
+    shell:
+        "python -m deckgen.calibration_studies quasistatic {input.card} --out {params.out} "
+        "--cache {params.cache} {params.engine} > {log} 2>&1"
+
+
+# the per-rock results table of issue #3:  snakemake --cores 2 calibration_report
+rule calibration_table:
+    input:
+        cards=expand(f"{RESULTS}/calibration/{{rock}}/card.yaml", rock=CAL_ROCKS),
+        seeds=expand(f"{CAL_STUDIES}/seeds_{{rock}}.csv", rock=CAL_ROCKS),
+        qs=expand(f"{CAL_STUDIES}/quasistatic_{{rock}}.csv", rock=CAL_ROCKS),
+    output:
+        f"{RESULTS}/calibration/table.md",
+    params:
+        out=CAL_STUDIES,
+    shell:
+        "python -m deckgen.calibration_studies table {input.cards} --out {params.out} --write {output}"
+
+
+rule calibration_report:
+    input:
+        f"{RESULTS}/calibration/table.md",

@@ -345,18 +345,46 @@ FILL_HEIGHT_FACTOR = 2.2    # insertion box height / bed height
 RADIUS_CLASSES = 4
 
 
+BED_DATA = "bed.data"
+BEDS = ("settle", "packing")
+
+
+def write_granular_data(path: str | Path, *, title: str, box: Sequence[float], radius: np.ndarray,
+                        density: np.ndarray, x: np.ndarray, n_atom_types: int = 2) -> Path:
+    """Write a LIGGGHTS ``atom_style granular`` data file (Atoms: id type diameter density x y z; all type 1)."""
+    path = Path(path)
+    n = len(radius)
+    with open(path, "w") as fh:
+        fh.write(f"{title}\n\n{n} atoms\n{int(n_atom_types)} atom types\n\n")
+        for k, ax in enumerate("xyz"):
+            fh.write(f"{box[2 * k]:.9e} {box[2 * k + 1]:.9e} {ax}lo {ax}hi\n")
+        fh.write("\nAtoms\n\n")
+        for i in range(n):
+            fh.write(f"{i + 1} 1 {2.0 * radius[i]:.9e} {density[i]:.9e} {x[i, 0]:.9e} {x[i, 1]:.9e} {x[i, 2]:.9e}\n")
+    return path
+
+
 def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density: float = 0.0,
-                        radius_classes: int = RADIUS_CLASSES) -> dict[str, Any]:
+                        radius_classes: int = RADIUS_CLASSES, bed: str = "settle", cache: Path | None = None,
+                        command: list[str] | None = None, mesh_dump_every: int = 0) -> dict[str, Any]:
     """Render a LIGGGHTS run folder: an unbonded granular bed cut by the case's STL disc.
 
-    ``cohesion_energy_density`` [J/m^3] > 0 switches on SJKR cohesion (grain-grain only).
-    Writes ``in.liggghts``, ``cutter.stl`` (+ ``cutter_shell.stl``, unused) and ``spec.json``;
-    returns the spec.json content.
+    ``bed``: ``settle`` (LIGGGHTS inserts the grains and settles them under gravity, walls on all
+    sides, trimmed to the block height) or ``packing`` (the case's packing from
+    :func:`deckgen.packing.ensure_packing`, the same grains, radius shrink, fixed faces, time step
+    and no gravity as the LAMMPS deck with ``bonds.enabled: false``: the cross-engine bed; ``cache``
+    and ``command`` go to ensure_packing). ``cohesion_energy_density`` [J/m^3] > 0 switches on SJKR
+    cohesion (grain-grain only). ``mesh_dump_every`` > 0 dumps the moved cutter mesh
+    (``cutter_mesh_<step>.stl``). Writes ``in.liggghts``, ``cutter.stl`` (+ ``cutter_shell.stl``,
+    unused), ``bed.data`` (bed ``packing``) and ``spec.json``; returns the spec.json content.
     """
     from deckgen.bonds import contact_timestep
-    from deckgen.deck import build_cutter_files, cutter_path
-    from deckgen.packing import specimen_region
+    from deckgen.deck import build_cutter_files, cutter_path, fixed_face_boxes
+    from deckgen.packing import ensure_packing, load_packing, specimen_region
     from deckgen.render import render
+
+    if bed not in BEDS:
+        raise SpecError(f"bed: {bed!r} is not one of {', '.join(BEDS)}")
 
     sp = case.specimen
     if not isinstance(sp, CuttingBlock):
@@ -390,8 +418,16 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     fractions[-1] = 1.0 - sum(fractions[:-1])
     classes = [{"radius": r, "fraction": f, "seed": s} for r, f, s in zip(radii, fractions, seeds)]
 
+    # ---- bed from the case's packing (same grains, shrink and time step as the LAMMPS deck)
+    grains = None
+    if bed == "packing":
+        atoms, packinfo = load_packing(ensure_packing(case, cache, progress=False, command=command))
+        r_bed = atoms.radius * (1.0 - case.bonds.shrink_before_bonding)
+        grains = {"x": atoms.x, "r": r_bed, "r_full_max": float(atoms.radius.max()), "key": packinfo["key"]}
+
     # ---- time step and phases
-    dt = run.timestep_s or contact_timestep(rmin, rho, E_c, nu_c, safety=0.2)
+    r_dt = float(grains["r"].min()) if grains else rmin
+    dt = run.timestep_s or contact_timestep(r_dt, rho, E_c, nu_c, safety=0.2)
     h_fill = FILL_HEIGHT_FACTOR * H
     fill_fraction = min(0.36, 1.15 * 0.60 * H / h_fill)
     g_settle = SETTLE_G_FACTOR * 9.81
@@ -400,7 +436,7 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     settle_steps = _round_up(int(math.ceil(3.0 * t_fall / dt)), run.thermo_every)
     relax_steps = _round_up(int(math.ceil(0.5 * t_fall / dt)), run.thermo_every)
     nsteps = _round_up(int(math.ceil(path["duration"] / dt)), quantum)
-    total = settle_steps + 2 * relax_steps + nsteps
+    total = nsteps if grains else settle_steps + 2 * relax_steps + nsteps
     if total > run.max_steps:
         raise SpecError(f"run.max_steps: the LIGGGHTS cut needs {total} steps at dt {dt:.3g} s "
                         "(fix: raise run.max_steps, shorten kinematics.travel_mm or raise speed_m_s)")
@@ -412,7 +448,19 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     xhi = max(L + pad, path["xc0"] + path["travel"] + R + 2 * e + pad)
     yhi = max(W / 2, half_width) + pad
     zhi = max(h_fill, path["zc0"] + R + 2 * e) + pad
+    if grains:  # no walls: room above for the grains the disc throws up (fixed boundaries lose them)
+        zhi = max(zhi, H + 2.0 * R + pad)
+        if path["rotary_radius"]:
+            yhi = max(yhi, path["rotary_radius"] * (1 - math.cos(path["travel"] / path["rotary_radius"])) + R + pad)
     box = [xlo, xhi, -yhi, yhi, -pad, zhi]
+    data_file = None
+    fixed_faces: list[dict[str, Any]] = []
+    if grains:
+        data_file = BED_DATA
+        write_granular_data(out / BED_DATA, title=f"deckgen {case.name} packing {grains['key']}", box=box,
+                            radius=grains["r"], density=np.full(len(grains["r"]), rho), x=grains["x"])
+        fixed_faces = fixed_face_boxes(sp, specimen_region(case), 2.0 * grains["r_full_max"],
+                                       3.0 * float(grains["r"].max()))
 
     walls_all = [("zmin", "zplane", 0.0), ("xmin", "xplane", 0.0), ("xmax", "xplane", L),
                  ("ymin", "yplane", -W / 2), ("ymax", "yplane", W / 2)]
@@ -466,19 +514,22 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         "seed_pdd": seeds[n_cls], "seed_ins": seeds[n_cls + 1],
         "fill_bounds": [0.0, L, -W / 2, W / 2, 0.0, h_fill],
         "above_bounds": [box[0], box[1], box[2], box[3], H, box[5]],
-        "stl": "cutter.stl", "oscillation": oscillation, "spin_fix": spin_fix,
+        "stl": "cutter.stl", "oscillation": oscillation, "spin_fix": spin_fix, "data_file": data_file,
+        "fixed_faces": fixed_faces, "mesh_dump_every": int(mesh_dump_every),
     }
     (out / DECK).write_text(render("liggghts/cut_bed.liggghts.j2", ctx))
     reg = specimen_region(case)
     mean_v = 4.0 / 3.0 * math.pi * float(np.mean(np.asarray(radii) ** 3))
     derived = {
         "engine": "liggghts", "bonded": False, "dt_s": dt, "dt_contact_s": dt,
-        "n_grains": int(round(0.6 * reg.volume_m3 / mean_v)), "n_grains_is_estimate": True,
-        "n_bonds": 0, "specimen_volume_m3": reg.volume_m3, "radius_classes_m": radii,
+        "n_grains": len(grains["r"]) if grains else int(round(0.6 * reg.volume_m3 / mean_v)),
+        "n_grains_is_estimate": not grains, "bed": bed, "packing_key": grains["key"] if grains else None,
+        "n_bonds": 0, "specimen_volume_m3": reg.volume_m3, "radius_classes_m": None if grains else radii,
         "cohesion_energy_density_J_m3": cohesion_energy_density,
-        "settle": {"g_m_s2": g_settle, "fill_height_m": h_fill, "fill_fraction": fill_fraction,
-                   "settle_steps": settle_steps, "relax_steps": relax_steps},
-        "walls_during_cut": sorted(keep),
+        "settle": None if grains else {"g_m_s2": g_settle, "fill_height_m": h_fill, "fill_fraction": fill_fraction,
+                                       "settle_steps": settle_steps, "relax_steps": relax_steps},
+        "walls_during_cut": [] if grains else sorted(keep),
+        "fixed_faces": [f["name"] for f in fixed_faces],
         "cutter": {kk: float(v) for kk, v in path.items()},
         "cutter_summary": {kk: (float(v) if isinstance(v, (int, float, np.floating)) else v)
                            for kk, v in files["summary"].items()},
@@ -490,6 +541,36 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     spec["case"]["engine"] = "liggghts"
     (out / "spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
     return spec
+
+
+def read_stl_triangles(path: str | Path) -> np.ndarray:
+    """Triangles (n, 3, 3) [m] of an ASCII STL (``dump mesh/stl`` output), streamed line by line."""
+    from deckgen.parse.common import ParseError, open_text
+
+    path = Path(path)
+    verts: list[list[float]] = []
+    with open_text(path) as fh:
+        for lineno, line in enumerate(fh, 1):
+            w = line.split()
+            if w and w[0] == "vertex":
+                try:
+                    verts.append([float(w[1]), float(w[2]), float(w[3])])
+                except (IndexError, ValueError):
+                    raise ParseError(path, lineno, "bad vertex line") from None
+    if len(verts) % 3:
+        raise ParseError(path, 0, f"{len(verts)} vertices: not whole triangles")
+    return np.asarray(verts, dtype=float).reshape(-1, 3, 3)
+
+
+def rigid_cutter_position(p0: np.ndarray, path: Mapping[str, float], t: float) -> np.ndarray:
+    """Where points ``p0`` of the disc at rest (centre at the origin, axis y) are at cut time ``t``:
+    centre x_c = x_c0 + V t + e (cos wt - 1), z_c = z_c0 + e sin wt, spin th = spin_rate t about +y
+    (x' = x cos th + z sin th, z' = -x sin th + z cos th, as the LAMMPS cutting deck)."""
+    V, e, w, s = path["V"], path["ecc"], path["omega"], path["spin_rate"]
+    th = s * t
+    c = np.array([path["xc0"] + V * t + e * (math.cos(w * t) - 1.0), path["yc0"], path["zc0"] + e * math.sin(w * t)])
+    x, y, z = p0[..., 0], p0[..., 1], p0[..., 2]
+    return np.stack([x * math.cos(th) + z * math.sin(th), y, -x * math.sin(th) + z * math.cos(th)], axis=-1) + c
 
 
 # =============================================================================== bond/gran (fork)

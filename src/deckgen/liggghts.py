@@ -76,7 +76,7 @@ import numpy as np
 from deckgen import __version__
 from deckgen.deck import _round_up, _var, path_variables
 from deckgen.runner import EngineError, run_deck, default_ranks
-from deckgen.spec import GPA, MM, MPA, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
+from deckgen.spec import GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
 
 ENV_BINARY = "DECKGEN_LIGGGHTS"
 DEBIAN_BINARY = "/usr/bin/liggghts"
@@ -391,8 +391,6 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         raise SpecError(f"specimen.kind: render_liggghts_cut needs a cutting_block, got {sp.kind} "
                         "(fix: use a cutting case)")
     k = case.kinematics
-    if k.mode == "indentation":
-        raise SpecError("kinematics.mode: indentation is not rendered for LIGGGHTS yet (fix: use linear or oscillation)")
     if not (math.isfinite(cohesion_energy_density) and cohesion_energy_density >= 0):
         raise SpecError("cohesion_energy_density must be a finite number >= 0 J/m^3")
     out = Path(out)
@@ -450,8 +448,8 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     zhi = max(h_fill, path["zc0"] + R + 2 * e) + pad
     if grains:  # no walls: room above for the grains the disc throws up (fixed boundaries lose them)
         zhi = max(zhi, H + 2.0 * R + pad)
-        if path["rotary_radius"]:
-            yhi = max(yhi, path["rotary_radius"] * (1 - math.cos(path["travel"] / path["rotary_radius"])) + R + pad)
+    if path["rotary_radius"]:  # the curved path drifts toward +y
+        yhi = max(yhi, path["rotary_radius"] * (1 - math.cos(path["travel"] / path["rotary_radius"])) + R + pad)
     box = [xlo, xhi, -yhi, yhi, -pad, zhi]
     data_file = None
     fixed_faces: list[dict[str, Any]] = []
@@ -499,6 +497,11 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         _var("x_shaft", path["xc0"] - path["ecc"], "eccentric shaft axis x at t = 0", "m"),
         _var("period_osc", 2 * math.pi / path["omega"] if oscillation else 1.0, "oscillation period", "s"),
         _var("spin_rate", path["spin_rate"], "net spin of the disc about +y", "rad/s"),
+        *([_var("r_rot", path["rotary_radius"], "rotary path radius", "m"),
+           _var("yaw_rate", path["yaw_rate"], "yaw rate of the disc on its circular path (v/r)", "rad/s"),
+           _var("period_yaw", 2 * math.pi / path["yaw_rate"], "period of the yaw rotation", "s"),
+           _var("ax_x", path["axis_x"], "rotary axis x", "m"),
+           _var("ax_y", path["axis_y"], "rotary axis y", "m")] if k.mode == "rotary" else []),
         _var("nsteps", nsteps, "steps of the cut", "steps"),
         _var("thermo_every", run.thermo_every, "thermo interval", "steps"),
         _var("series_every", case.outputs.series_every, "time-series interval", "steps"),
@@ -515,7 +518,8 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         "fill_bounds": [0.0, L, -W / 2, W / 2, 0.0, h_fill],
         "above_bounds": [box[0], box[1], box[2], box[3], H, box[5]],
         "stl": "cutter.stl", "oscillation": oscillation, "spin_fix": spin_fix, "data_file": data_file,
-        "fixed_faces": fixed_faces, "mesh_dump_every": int(mesh_dump_every),
+        "fixed_faces": fixed_faces, "mesh_dump_every": int(mesh_dump_every), "rotary": k.mode == "rotary",
+        "indent": k.mode == "indentation",
     }
     (out / DECK).write_text(render("liggghts/cut_bed.liggghts.j2", ctx))
     reg = specimen_region(case)
@@ -535,7 +539,8 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
                            for kk, v in files["summary"].items()},
         "expected_steps": nsteps, "expected_steps_total": total,
         "steady_window": list(case.outputs.steady_window), "kinematics_mode": k.mode,
-        "stacked_moves": ["linear"] + (["rotate_orbit"] if oscillation else []) + (["rotate_spin"] if spin_fix else []),
+        "stacked_moves": (["rotate_yaw"] if k.mode == "rotary" else ["linear"]) + (["rotate_orbit"] if oscillation else [])
+        + (["rotate_spin"] if spin_fix else []),
     }
     spec = {"deckgen_version": __version__, "engine": "liggghts", "case": resolved_dict(case), "derived": derived}
     spec["case"]["engine"] = "liggghts"
@@ -568,9 +573,40 @@ def rigid_cutter_position(p0: np.ndarray, path: Mapping[str, float], t: float) -
     (x' = x cos th + z sin th, z' = -x sin th + z cos th, as the LAMMPS cutting deck)."""
     V, e, w, s = path["V"], path["ecc"], path["omega"], path["spin_rate"]
     th = s * t
-    c = np.array([path["xc0"] + V * t + e * (math.cos(w * t) - 1.0), path["yc0"], path["zc0"] + e * math.sin(w * t)])
     x, y, z = p0[..., 0], p0[..., 1], p0[..., 2]
-    return np.stack([x * math.cos(th) + z * math.sin(th), y, -x * math.sin(th) + z * math.cos(th)], axis=-1) + c
+    spun = np.stack([x * math.cos(th) + z * math.sin(th), y, -x * math.sin(th) + z * math.cos(th)], axis=-1)
+    if path.get("rotary_radius", 0.0):  # p = A + Rz(phi) [(c0 - A) + Ry(th) p0], phi = yaw_rate t
+        phi = path["yaw_rate"] * t
+        q = spun + np.array([path["xc0"] - path["axis_x"], path["yc0"] - path["axis_y"], 0.0])
+        rot = np.stack([q[..., 0] * math.cos(phi) - q[..., 1] * math.sin(phi),
+                        q[..., 0] * math.sin(phi) + q[..., 1] * math.cos(phi), q[..., 2]], axis=-1)
+        return rot + np.array([path["axis_x"], path["axis_y"], path["zc0"]])
+    if path.get("mode_indent", 0.0):
+        return spun + np.array([path["xc0"], path["yc0"], path["zc0"] - V * t])
+    c = np.array([path["xc0"] + V * t + e * (math.cos(w * t) - 1.0), path["yc0"], path["zc0"] + e * math.sin(w * t)])
+    return spun + c
+
+
+def render_liggghts(case: Case, out: str | Path, *, bed: str = "packing", cache: Path | None = None,
+                    command: list[str] | None = None) -> dict[str, Any]:
+    """Render any case for LIGGGHTS, or refuse it in one line (:class:`SpecError`) saying what to change.
+
+    cutting + ``bonds.enabled: false``: :func:`render_liggghts_cut` (``bed`` packing or settle);
+    ucs / bts with bonds: :func:`render_liggghts_ucs_bonded` / :func:`render_liggghts_bts_bonded`
+    (Flexible_Fibers fork).
+    """
+    bonded = case.bonds.enabled
+    if case.test == "cutting":
+        if bonded:
+            raise SpecError(f"case {case.name}: engine liggghts renders unbonded cutting beds only (a bonded cutting block "
+                            "for the bond/gran fork is not written yet) (fix: bonds.enabled: false, or engine: lammps)")
+        return render_liggghts_cut(case, out, bed=bed, cache=cache, command=command)
+    if not bonded:
+        raise SpecError(f"case {case.name}: engine liggghts renders {case.test} specimens bonded only "
+                        "(fix: bonds.enabled: true, or engine: lammps)")
+    if case.test == "ucs":
+        return render_liggghts_ucs_bonded(case, out)
+    return render_liggghts_bts_bonded(case, out)
 
 
 # =============================================================================== bond/gran (fork)
@@ -757,19 +793,44 @@ def _platen_stl(path: Path, radius: float, z: float, thickness: float, down: boo
 def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     """Render a bonded UCS deck for the Flexible_Fibers fork (golden-tested and grammar-checked only).
 
-    Grains are inserted into the cylinder and settled on the bottom platen by LIGGGHTS, bonded
+    Grains are inserted into the cylinder and settled on the bottom platen by LIGGGHTS, trimmed
+    to the height (centres above H - r_max deleted; the top platen mesh is placed only then), bonded
     once with ``fix bond/create/gran`` (cutoff (1 + gap_tolerance) x the mean grain diameter: the
     fork's bond creation has one cutoff, it is not radius-aware), then loaded by the top platen.
     """
+    if not isinstance(case.specimen, UcsCylinder):
+        raise SpecError(f"specimen.kind: render_liggghts_ucs_bonded needs ucs_cylinder, got {case.specimen.kind}")
+    return _render_platen_bonded(case, out)
+
+
+def render_liggghts_bts_bonded(case: Case, out: str | Path) -> dict[str, Any]:
+    """Render a bonded Brazilian test deck for the Flexible_Fibers fork (golden-tested and grammar-checked only).
+
+    The disc (axis y, centre (0, R) in x-z, as :func:`deckgen.packing.specimen_region`) is made by
+    insertion and settling in a box 2R wide between y walls, trimmed to the disc (grains with their
+    centre above 2R - r_max or farther than R - r_max from the axis are deleted, so no grain crosses
+    the platens), bonded once as the UCS deck, and loaded across its diameter by flat platen meshes
+    (bottom at z = 0, top at z = 2R moving down). Stress = F / (pi D t / 2) (the Brazilian tensile
+    stress 2F/(pi D t), as the LAMMPS deck); strain = platen displacement / D.
+    """
+    if not isinstance(case.specimen, BrazilianDisc):
+        raise SpecError(f"specimen.kind: render_liggghts_bts_bonded needs brazilian_disc, got {case.specimen.kind}")
+    return _render_platen_bonded(case, out)
+
+
+def _render_platen_bonded(case: Case, out: str | Path) -> dict[str, Any]:
+    """The bonded platen decks (UCS cylinder, Brazilian disc) for the Flexible_Fibers fork."""
     from deckgen.render import render
 
     sp = case.specimen
-    if not isinstance(sp, UcsCylinder):
-        raise SpecError(f"specimen.kind: render_liggghts_ucs_bonded needs ucs_cylinder, got {sp.kind}")
+    bts = isinstance(sp, BrazilianDisc)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     b, c, p, run = case.bonds, case.contact, case.packing, case.run
-    Rc, Hc = sp.diameter_mm * MM / 2, sp.height_mm * MM
+    if bts:
+        Rc, Hc, thick = sp.diameter_mm * MM / 2, sp.diameter_mm * MM, sp.thickness_mm * MM
+    else:
+        Rc, Hc = sp.diameter_mm * MM / 2, sp.height_mm * MM
     rmin, rmax = p.radius_min_mm * MM, p.radius_max_mm * MM
     rho = case.material.density_kg_m3 * run.mass_scaling
     E_b = b.youngs_modulus_GPa * GPA
@@ -805,6 +866,10 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     nsteps = _round_up(int(math.ceil(sp.max_strain * Hc / v / dt)), case.outputs.series_every)
     margin = 2 * rmax + 6 * skin      # every grain stays > skin away from the box faces
     box = [-Rc - margin, Rc + margin, -Rc - margin, Rc + margin, -margin, fill_h + margin]
+    area = math.pi * Rc**2
+    if bts:
+        box[2:4] = [-thick / 2 - margin, thick / 2 + margin]
+        area = math.pi * (2 * Rc) * thick / 2.0  # sigma_t = F / area = 2F/(pi D t)
     _platen_stl(out / "platen_bottom.stl", Rc, 0.0, 2 * rmax, down=True)
     _platen_stl(out / "platen_top.stl", Rc, Hc, 2 * rmax, down=False)
     per_atom = 16
@@ -829,7 +894,11 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
         _var("settle_steps", settle_steps, "settling run", "steps"),
         _var("bond_cutoff", (1 + b.gap_tolerance) * (rmin + rmax), "bond creation cutoff (centre distance)", "m"),
         _var("v_platen", v, "top platen speed (down)", "m/s"),
-        _var("area", math.pi * Rc**2, "stress area pi R^2", "m^2"),
+        _var("area", area, "stress area (UCS pi R^2, BTS pi D t / 2)", "m^2") if bts else
+        _var("area", area, "stress area pi R^2", "m^2"),
+        *([_var("thickness", thick, "disc thickness (y)", "m"),
+           _var("trim_radius", Rc - rmax, "grains with their centre farther from the disc axis are deleted", "m")]
+          if bts else []),
         _var("nsteps", nsteps, "loading steps (max strain)", "steps"),
         _var("thermo_every", run.thermo_every, "thermo interval", "steps"),
         _var("series_every", case.outputs.series_every, "time-series interval", "steps"),
@@ -837,20 +906,31 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     rolling = c.rolling_friction > 0
     ctx = {
         "version": __version__, "case_name": case.name, "test": case.test, "deck_name": DECK,
-        "title": "uniaxial compression of a bonded cylinder (bond/gran fork)", "template": "ucs_bonded.liggghts.j2",
+        "title": "Brazilian test of a bonded disc (bond/gran fork)" if bts else
+        "uniaxial compression of a bonded cylinder (bond/gran fork)",
+        "template": "bts_bonded.liggghts.j2" if bts else "ucs_bonded.liggghts.j2",
         "variables": variables, "hard_particles": True, "box": box, "n_atom_types": 2,
         "atom_style": ["hybrid", "granular", "bond/gran", "n_bondtypes", 1, "bonds_per_atom", per_atom,
                        "disableNormalContact", 1],
         "rolling": rolling, "cohesion": False, "contact_model": contact_model(rolling, False), "bond": bond,
         "bonds_per_atom": per_atom, "radius_classes": classes, "n_classes": n_cls, "seed_pdd": seeds[n_cls],
         "seed_ins": seeds[n_cls + 1], "platen_bottom": "platen_bottom.stl", "platen_top": "platen_top.stl",
+        "above_bounds": [box[0], box[1], box[2], box[3], Hc - rmax, box[5]],
     }
-    text = render("liggghts/ucs_bonded.liggghts.j2", ctx)
+    if bts:
+        ctx.update({
+            "fill_bounds": [-Rc, Rc, -thick / 2, thick / 2, 0.0, fill_h],
+            "mould_walls": [{"id": f"w_{n}", "plane": pl, "position": pos} for n, pl, pos in
+                            (("xmin", "xplane", -Rc), ("xmax", "xplane", Rc), ("ymin", "yplane", -thick / 2),
+                             ("ymax", "yplane", thick / 2))],
+            "trim_y": [box[2], box[3]],
+        })
+    text = render("liggghts/" + ctx["template"], ctx)
     check_bonded_deck(text)
     (out / DECK).write_text(text)
     derived = {"engine": "liggghts", "bonded": True, "dt_s": dt, "bond_gran": bond, "n_bonds": 0,
-               "n_grains": 0, "expected_steps": nsteps, "expected_steps_total": settle_steps + 1 + nsteps,
-               "height_m": Hc, "area_m2": math.pi * Rc**2, "platen_speed_m_s": v}
+               "n_grains": 0, "expected_steps": nsteps, "expected_steps_total": settle_steps + run.thermo_every + 1 + nsteps,
+               "height_m": Hc, "area_m2": area, "platen_speed_m_s": v}
     spec = {"deckgen_version": __version__, "engine": "liggghts", "case": resolved_dict(case), "derived": derived}
     spec["case"]["engine"] = "liggghts"
     (out / "spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")

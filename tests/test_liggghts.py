@@ -407,3 +407,25 @@ def test_cli_render_liggghts_every_family(tmp_path, capsys):
     assert main(["render", str(DATA / "cases" / "tiny_cut.yaml"), "--engine", "liggghts", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("deckgen: error:") and "bonds.enabled: false" in err and "\n" not in err
+
+
+# ------------------------------------------------------------------------------- cross-engine (small)
+@needs_liggghts
+def test_cross_engine_small(tmp_path):
+    """The same unbonded bed (the committed tiny_cut packing, ~450 grains), disc and linear motion on
+    LAMMPS and LIGGGHTS: both see the bed resist (F_r > 0, F_n > 0) and the steady means agree within
+    the tolerance of one tiny bed (factor 2.5; the statistical tolerance is measured by
+    bench/cross_engine.py, see docs/liggghts.md)."""
+    case = load_case(DATA / "cases" / "tiny_cut.yaml", overrides={
+        "bonds": {"enabled": False}, "contact": {"rolling_friction": 0.0},
+        "kinematics": {"mode": "linear", "spin": "none", "travel_mm": 3.0}})
+    cache = tmp_path / "cache"
+    _install_packing(case, "tiny_cut", cache)
+    r = lg.cross_engine_cut(case, tmp_path, cache=cache, ranks=1, timeout_s=300)
+    print({k: {q: round(v, 4) for q, v in r[k].items() if isinstance(v, float)} for k in ("lammps", "liggghts", "ratio")})
+    assert r["lammps"]["n_grains"] == r["liggghts"]["n_grains"]
+    for eng in ("lammps", "liggghts"):
+        assert r[eng]["force_rolling_N_mean_steady"] > 0 and r[eng]["force_normal_N_mean_steady"] > 0
+        assert r[eng]["contact_fraction_steady_1"] > 0.1  # measured: LAMMPS 0.125, LIGGGHTS 0.46 (tiny, stiff, loose)
+    for q in ("force_rolling_N_mean_steady", "force_normal_N_mean_steady"):
+        assert 1 / 2.5 < r["ratio"][q] < 2.5, (q, r["ratio"][q])

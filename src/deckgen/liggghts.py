@@ -609,6 +609,48 @@ def render_liggghts(case: Case, out: str | Path, *, bed: str = "packing", cache:
     return render_liggghts_bts_bonded(case, out)
 
 
+#: summary quantities compared by :func:`cross_engine_cut` (cutter frame, steady window)
+CROSS_QUANTITIES = ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
+                    "contact_fraction_steady_1")
+
+
+def cross_engine_cut(case: Case, out: str | Path, *, cache: Path | None = None, ranks: int = 1,
+                     timeout_s: float | None = 1800) -> dict[str, Any]:
+    """Cut the same unbonded bed with the same disc and motion on LAMMPS and on LIGGGHTS.
+
+    The case must have ``bonds.enabled: false``. LAMMPS: :func:`deckgen.deck.render_case` (the
+    case's packing, radii shrunk by ``shrink_before_bonding``, no bond, cutter = rigid shell of
+    spheres on the STL offset inward by their radius). LIGGGHTS: :func:`render_liggghts_cut` with
+    ``bed="packing"`` (the same grains from the same packing, the same fixed faces, time step and
+    motion, no gravity; cutter = the STL mesh itself). Both runs are parsed with
+    :func:`deckgen.results.parse_run`; returns ``{"lammps": {...}, "liggghts": {...}, "ratio":
+    {q: liggghts / lammps}}`` for :data:`CROSS_QUANTITIES`, plus the folders.
+    """
+    from deckgen.deck import render_case
+    from deckgen.results import parse_run
+    from deckgen.runner import engine_command, run_deck
+
+    if case.test != "cutting" or case.bonds.enabled:
+        raise SpecError(f"case {case.name}: the cross-engine check needs a cutting case with bonds.enabled: false")
+    out = Path(out)
+    lmp_cmd = engine_command(ranks)
+    res: dict[str, Any] = {}
+    for eng in ("lammps", "liggghts"):
+        d = out / eng
+        c = case.model_copy(update={"engine": eng})
+        if eng == "lammps":
+            render_case(c, d, cache=cache, progress=False, command=lmp_cmd)
+            run_deck(d, "in.deck", command=lmp_cmd, progress=False, timeout_s=timeout_s, label=f"lammps {case.name}")
+        else:
+            render_liggghts_cut(c, d, bed="packing", cache=cache, command=lmp_cmd)
+            run_liggghts(d, ranks=ranks, timeout_s=timeout_s)
+        s = parse_run(d, d / "parsed")
+        res[eng] = {q: s[q] for q in CROSS_QUANTITIES} | {"n_grains": s["n_grains"], "dir": str(d)}
+    res["ratio"] = {q: (res["liggghts"][q] / res["lammps"][q] if res["lammps"][q] else float("nan"))
+                    for q in CROSS_QUANTITIES}
+    return res
+
+
 # =============================================================================== bond/gran (fork)
 #: damp type -> number of damping values (BondGran::coeff, src/bond_gran.cpp of the fork at
 #: commit 0ea55cc3268c25e2fd0d06a0523fa5e1a1dcbc50): 0 none (one unused value), 1 Yu Guo

@@ -287,3 +287,145 @@ def test_bonded_ucs_runs_on_fork(tmp_path):
     lg.run_liggghts(tmp_path, ranks=1, timeout_s=1800)
     d = read_series(tmp_path / "series.txt")
     assert (d["bonds"] > 0).all()
+
+
+# ------------------------------------------------------------------------------- oscillation, run
+def _install_packing(case, name, cache):
+    """The committed packing fixture of golden case ``name`` as ``case``'s cached packing (no engine)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("regen", DATA / "golden" / "regenerate.py")
+    regen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(regen)
+    regen.install_fixture(case, name, cache)
+
+
+@needs_liggghts
+def test_oscillation_stacked_moves_run(tmp_path):
+    """Eccentric oscillation + rolling spin on Debian LIGGGHTS: the mesh reference point follows
+    x_c = x_c0 + V t + e (cos wt - 1), z_c = z_c0 + e sin wt, and every dumped mesh vertex is the
+    rest disc turned by spin_rate t about +y and carried by the centre (the orbit's own spin is
+    cancelled by the correction move)."""
+    case = load_case(DATA / "cases" / "tiny_cut.yaml", overrides={"engine": "liggghts", "bonds": {"enabled": False},
+                                                                 "kinematics": {"travel_mm": 2.0}})
+    cache = tmp_path / "cache"
+    _install_packing(case, "tiny_cut", cache)
+    spec = lg.render_liggghts_cut(case, tmp_path / "run", bed="packing", cache=cache, command=["false"],
+                                  mesh_dump_every=1000)
+    path, dt = spec["derived"]["cutter"], spec["derived"]["dt_s"]
+    assert path["ecc"] > 0 and path["omega"] > 0 and path["spin_rate"] > 0
+    lg.run_liggghts(tmp_path / "run", ranks=1, timeout_s=300)
+    d = read_series(tmp_path / "run" / "series.txt")
+    t = d["time_s"].to_numpy()
+    assert t[-1] * path["omega"] > 2 * math.pi  # more than one oscillation period
+    xc = path["xc0"] + path["V"] * t + path["ecc"] * (np.cos(path["omega"] * t) - 1)
+    zc = path["zc0"] + path["ecc"] * np.sin(path["omega"] * t)
+    err_ref = max(np.abs(d["ref_x_m"] - xc).max(), np.abs(d["ref_z_m"] - zc).max(), np.abs(d["ref_y_m"] - path["yc0"]).max())
+    assert err_ref < 1e-9, err_ref
+    import trimesh
+
+    rest = np.asarray(trimesh.load_mesh(tmp_path / "run" / "cutter.stl", process=False).triangles)  # binary STL
+    dumps = sorted((tmp_path / "run").glob("cutter_mesh_*.stl"), key=lambda p: int(p.stem.rsplit("_", 1)[1]))
+    assert len(dumps) >= 4
+    errs = []
+    for f in dumps:
+        step = int(f.stem.rsplit("_", 1)[1])
+        tri = lg.read_stl_triangles(f)
+        assert tri.shape == rest.shape
+        errs.append(np.abs(tri - lg.rigid_cutter_position(rest, path, step * dt)).max())
+    # the dump's ASCII precision bounds the agreement; a spin error of one time step would be ~R spin_rate dt
+    R = spec["derived"]["cutter_summary"]["diameter_m"] / 2
+    print(f"oscillation: reference point error {err_ref:.2e} m, mesh vertex error {max(errs):.2e} m "
+          f"(R spin_rate dt = {R * path['spin_rate'] * dt:.2e} m)")
+    assert max(errs) < 1e-7, errs
+
+
+def test_bonded_bts_deck_golden_and_grammar(tmp_path):
+    case = load_case(DATA / "cases" / "tiny_bts.yaml")
+    spec = lg.render_liggghts(case, tmp_path)
+    text = (tmp_path / "in.liggghts").read_text()
+    g = lg.check_bonded_deck(text)
+    assert g["bond_coeffs"][0]["Y"] == case.bonds.youngs_modulus_GPa * GPA
+    D, t = case.specimen.diameter_mm * 1e-3, case.specimen.thickness_mm * 1e-3
+    assert spec["derived"]["area_m2"] == pytest.approx(math.pi * D * t / 2)   # sigma_t = 2F/(pi D t)
+    assert spec["derived"]["height_m"] == pytest.approx(D)
+    # disc trimmed from the settled box: centres within R - r_max of the axis (0, R), below 2R - r_max
+    assert re.search(r"region +outside cylinder y 0.0 \$\{radius\} \$\{trim_radius\} \S+ \S+ side out units box", text)
+    # the top platen exists only after the specimen is made (no grain settles on top of it)
+    assert text.index("delete_atoms    region above") < text.index("fix             top all mesh/surface/stress")
+    golden = DATA / "liggghts" / "tiny_bts_bonded.in.liggghts"
+    if os.environ.get("DECKGEN_REGEN_GOLDEN"):
+        golden.write_text(text)
+    assert text == golden.read_text(), "bonded LIGGGHTS BTS deck changed: DECKGEN_REGEN_GOLDEN=1 pytest to accept"
+
+
+@pytest.mark.parametrize("name,overrides,match", [
+    ("tiny_ucs", {"bonds": {"enabled": False}}, "bonded only"),        # unbonded UCS
+    ("tiny_bts", {"bonds": {"enabled": False}}, "bonded only"),
+    ("tiny_cut", {}, "unbonded cutting beds only"),                     # bonded cutting block
+])
+def test_render_liggghts_refuses_in_one_line(tmp_path, name, overrides, match):
+    from deckgen.spec import SpecError
+
+    case = load_case(DATA / "cases" / f"{name}.yaml", overrides=overrides)
+    with pytest.raises(SpecError, match=match) as exc:
+        lg.render_liggghts(case, tmp_path)
+    assert "\n" not in str(exc.value) and "fix:" in str(exc.value)
+
+
+def test_cli_render_liggghts_every_family(tmp_path, capsys):
+    """deckgen render --engine liggghts: bonded UCS and BTS decks, unbonded linear / oscillation /
+    rotary / indentation cuts of the case's packing; unsupported combinations end in one line."""
+    from deckgen.cli import main
+
+    cache = tmp_path / "cache"
+    for name in ("tiny_ucs", "tiny_bts"):
+        assert main(["render", str(DATA / "cases" / f"{name}.yaml"), "--engine", "liggghts", "--out",
+                     str(tmp_path / name)]) == 0
+    for name in ("tiny_cut", "tiny_rotary", "tiny_indent"):
+        src = DATA / "cases" / f"{name}.yaml"
+        case_file = tmp_path / f"{name}.yaml"
+        case_file.write_text(src.read_text().replace("bonds:\n", "bonds:\n  enabled: false\n") + "engine: liggghts\n")
+        case = load_case(case_file)
+        fixture = "tiny_cut" if name == "tiny_indent" else name
+        if name == "tiny_indent":  # no committed packing: render the settled bed instead (no engine)
+            assert main(["render", str(case_file), "--out", str(tmp_path / name), "--bed", "settle"]) == 0
+        else:
+            _install_packing(case, fixture, cache)
+            assert main(["render", str(case_file), "--out", str(tmp_path / name), "--cache", str(cache),
+                         "--engine-cmd", "false"]) == 0
+        deck = (tmp_path / name / "in.liggghts").read_text()
+        assert "{{" not in deck
+        if name == "tiny_rotary":
+            assert re.search(r"fix +mv1 all move/mesh mesh cad rotate origin \$\{ax_x\} \$\{ax_y\} \$\{zc0\} axis 0.0 0.0 1.0 period \$\{period_yaw\}", deck)
+            assert "path_angle_rad" in deck and "read_data       bed.data" in deck
+        if name == "tiny_indent":
+            assert "linear 0.0 0.0 -${v_cut}" in deck and "variable        zc equal ${zc0}-${v_cut}*v_t" in deck
+    out = capsys.readouterr().out
+    assert out.count("for LIGGGHTS") == 5
+    # a bonded cutting block on liggghts: one line, exit code 2
+    assert main(["render", str(DATA / "cases" / "tiny_cut.yaml"), "--engine", "liggghts", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("deckgen: error:") and "bonds.enabled: false" in err and "\n" not in err
+
+
+# ------------------------------------------------------------------------------- cross-engine (small)
+@needs_liggghts
+def test_cross_engine_small(tmp_path):
+    """The same unbonded bed (the committed tiny_cut packing, ~450 grains), disc and linear motion on
+    LAMMPS and LIGGGHTS: both see the bed resist (F_r > 0, F_n > 0) and the steady means agree within
+    the tolerance of one tiny bed (factor 2.5; the statistical tolerance is measured by
+    bench/cross_engine.py, see docs/liggghts.md)."""
+    case = load_case(DATA / "cases" / "tiny_cut.yaml", overrides={
+        "bonds": {"enabled": False}, "contact": {"rolling_friction": 0.0},
+        "kinematics": {"mode": "linear", "spin": "none", "travel_mm": 3.0}})
+    cache = tmp_path / "cache"
+    _install_packing(case, "tiny_cut", cache)
+    r = lg.cross_engine_cut(case, tmp_path, cache=cache, ranks=1, timeout_s=300)
+    print({k: {q: round(v, 4) for q, v in r[k].items() if isinstance(v, float)} for k in ("lammps", "liggghts", "ratio")})
+    assert r["lammps"]["n_grains"] == r["liggghts"]["n_grains"]
+    for eng in ("lammps", "liggghts"):
+        assert r[eng]["force_rolling_N_mean_steady"] > 0 and r[eng]["force_normal_N_mean_steady"] > 0
+        assert r[eng]["contact_fraction_steady_1"] > 0.1  # measured: LAMMPS 0.125, LIGGGHTS 0.46 (tiny, stiff, loose)
+    for q in ("force_rolling_N_mean_steady", "force_normal_N_mean_steady"):
+        assert 1 / 2.5 < r["ratio"][q] < 2.5, (q, r["ratio"][q])

@@ -93,12 +93,15 @@ def cmd_render(args: argparse.Namespace) -> int:
     if case.engine == "liggghts":
         from deckgen import liggghts as lg
 
-        render_fn = {"cutting": lg.render_liggghts_cut, "ucs": lg.render_liggghts_ucs_bonded}.get(case.test)
-        if render_fn is None:
-            raise SpecError(f"{args.case}: engine: liggghts renders cutting beds and bonded UCS decks so far, "
-                            f"not {case.test} (fix: engine: lammps)")
-        render_fn(case, Path(args.out))
-        print(f"{args.case}: rendered {args.out}/{lg.DECK} for LIGGGHTS")
+        try:
+            spec = lg.render_liggghts(case, Path(args.out), bed=args.bed, cache=_cache(args), command=_command(args))
+        except SpecError as exc:
+            raise SpecError(f"{args.case}: {exc}") from None
+        d = spec["derived"]
+        what = (f"{d['n_grains']} grains" if not d.get("n_grains_is_estimate") and d.get("n_grains")
+                else "grains inserted by LIGGGHTS")
+        print(f"{args.case}: rendered {args.out}/{lg.DECK} for LIGGGHTS: {what}, dt {d['dt_s']:.3g} s, "
+              f"about {d['expected_steps_total']} steps")
         return 0
     spec = render_case(case, Path(args.out), cache=_cache(args), progress=not args.no_progress, command=_command(args))
     d = spec["derived"]
@@ -199,6 +202,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("case")
     s.add_argument("--out", required=True)
     s.add_argument("--engine", choices=["lammps", "liggghts"])
+    s.add_argument("--bed", choices=["packing", "settle"], default="packing",
+                   help="liggghts cutting: the case's packing (as LAMMPS; default) or a bed LIGGGHTS inserts and settles")
     engine_opts(s)
     s.set_defaults(func=cmd_render)
     s = sub.add_parser("run", help="run the engine in a rendered folder")

@@ -7,6 +7,7 @@ need (areas, lengths, time step, cutter path) are written beside the deck as ``s
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -141,6 +142,24 @@ def shell_points(shell_mesh, spacing: float, seed: int) -> np.ndarray:
     return np.asarray(keep)
 
 
+def fixed_face_boxes(sp: CuttingBlock, reg: Any, slab: float, pad: float) -> list[dict[str, Any]]:
+    """Boxes of the grains held fixed: a slab ``slab`` thick inside each of ``sp.fixed_faces``,
+    reaching ``pad`` beyond the block on every other side (shared by the LAMMPS and LIGGGHTS decks)."""
+    faces = []
+    for f in sp.fixed_faces:
+        bb = np.asarray(reg.bounds).reshape(3, 2).copy()
+        k = "xyz".index(f[0])
+        if f.endswith("min"):
+            bb[k] = (bb[k, 0] - pad, bb[k, 0] + slab)
+        else:
+            bb[k] = (bb[k, 1] - slab, bb[k, 1] + pad)
+        for kk in range(3):
+            if kk != k:
+                bb[kk] = (bb[kk, 0] - pad, bb[kk, 1] + pad)
+        faces.append({"name": f, "bounds": [float(v) for v in bb.ravel()]})
+    return faces
+
+
 def cutter_path(case: Case, R: float) -> dict[str, float]:
     """Initial centre, duration and motion parameters of the cutter (SI)."""
     sp = case.specimen
@@ -232,6 +251,10 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
     dt_contact = contact_timestep(float(r.min()), rho, E_c, nu_c, safety=0.2)
     dt = run.timestep_s or min(dt_info["dt_s"], dt_contact)
+    if not b.enabled:  # unbonded granular specimen: bond types stay declared (same deck), no bond exists
+        pairs = pairs[:0]
+        table = dataclasses.replace(table, pairs=pairs, types=table.types[:0], per_atom=np.zeros_like(table.per_atom))
+        dt = run.timestep_s or dt_contact
 
     # ---- contact constants
     r_mean = float(r.mean())
@@ -278,6 +301,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         "specimen_volume_m3": reg.volume_m3, "packing_key": packinfo["key"], "packing": packinfo["stats"],
         "bond_coefficients": {n: [float(v) for v in table.coeffs[n]] for n in COEFF_NAMES},
     }
+    if not b.enabled:
+        derived["bonded"] = False
     types = np.ones(len(r), dtype=int)
     x_all, r_all, rho_all = atoms.x, r, np.full(len(r), rho)
     n_atom_types = 1
@@ -396,20 +421,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("nsteps", steps, "steps of the cut", "steps"),
             _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
         ]
-        fixed_slab = 2.0 * float(r_full.max())
-        faces = []
-        for f in sp.fixed_faces:
-            bb = np.asarray(reg.bounds).reshape(3, 2).copy()
-            k = "xyz".index(f[0])
-            if f.endswith("min"):
-                bb[k] = (bb[k, 0] - pad, bb[k, 0] + fixed_slab)
-            else:
-                bb[k] = (bb[k, 1] - fixed_slab, bb[k, 1] + pad)
-            for kk in range(3):
-                if kk != k:
-                    bb[kk] = (bb[kk, 0] - pad, bb[kk, 1] + pad)
-            faces.append({"name": f, "bounds": [float(v) for v in bb.ravel()]})
-        ctx["fixed_faces"] = faces
+        ctx["fixed_faces"] = fixed_face_boxes(sp, reg, 2.0 * float(r_full.max()), pad)
         ctx["rotary"] = case.kinematics.mode == "rotary"
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),

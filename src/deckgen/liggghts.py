@@ -76,7 +76,7 @@ import numpy as np
 from deckgen import __version__
 from deckgen.deck import _round_up, _var, path_variables
 from deckgen.runner import EngineError, run_deck, default_ranks
-from deckgen.spec import GPA, MM, MPA, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
+from deckgen.spec import GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecError, UcsCylinder, resolved_dict
 
 ENV_BINARY = "DECKGEN_LIGGGHTS"
 DEBIAN_BINARY = "/usr/bin/liggghts"
@@ -345,26 +345,52 @@ FILL_HEIGHT_FACTOR = 2.2    # insertion box height / bed height
 RADIUS_CLASSES = 4
 
 
+BED_DATA = "bed.data"
+BEDS = ("settle", "packing")
+
+
+def write_granular_data(path: str | Path, *, title: str, box: Sequence[float], radius: np.ndarray,
+                        density: np.ndarray, x: np.ndarray, n_atom_types: int = 2) -> Path:
+    """Write a LIGGGHTS ``atom_style granular`` data file (Atoms: id type diameter density x y z; all type 1)."""
+    path = Path(path)
+    n = len(radius)
+    with open(path, "w") as fh:
+        fh.write(f"{title}\n\n{n} atoms\n{int(n_atom_types)} atom types\n\n")
+        for k, ax in enumerate("xyz"):
+            fh.write(f"{box[2 * k]:.9e} {box[2 * k + 1]:.9e} {ax}lo {ax}hi\n")
+        fh.write("\nAtoms\n\n")
+        for i in range(n):
+            fh.write(f"{i + 1} 1 {2.0 * radius[i]:.9e} {density[i]:.9e} {x[i, 0]:.9e} {x[i, 1]:.9e} {x[i, 2]:.9e}\n")
+    return path
+
+
 def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density: float = 0.0,
-                        radius_classes: int = RADIUS_CLASSES) -> dict[str, Any]:
+                        radius_classes: int = RADIUS_CLASSES, bed: str = "settle", cache: Path | None = None,
+                        command: list[str] | None = None, mesh_dump_every: int = 0) -> dict[str, Any]:
     """Render a LIGGGHTS run folder: an unbonded granular bed cut by the case's STL disc.
 
-    ``cohesion_energy_density`` [J/m^3] > 0 switches on SJKR cohesion (grain-grain only).
-    Writes ``in.liggghts``, ``cutter.stl`` (+ ``cutter_shell.stl``, unused) and ``spec.json``;
-    returns the spec.json content.
+    ``bed``: ``settle`` (LIGGGHTS inserts the grains and settles them under gravity, walls on all
+    sides, trimmed to the block height) or ``packing`` (the case's packing from
+    :func:`deckgen.packing.ensure_packing`, the same grains, radius shrink, fixed faces, time step
+    and no gravity as the LAMMPS deck with ``bonds.enabled: false``: the cross-engine bed; ``cache``
+    and ``command`` go to ensure_packing). ``cohesion_energy_density`` [J/m^3] > 0 switches on SJKR
+    cohesion (grain-grain only). ``mesh_dump_every`` > 0 dumps the moved cutter mesh
+    (``cutter_mesh_<step>.stl``). Writes ``in.liggghts``, ``cutter.stl`` (+ ``cutter_shell.stl``,
+    unused), ``bed.data`` (bed ``packing``) and ``spec.json``; returns the spec.json content.
     """
     from deckgen.bonds import contact_timestep
-    from deckgen.deck import build_cutter_files, cutter_path
-    from deckgen.packing import specimen_region
+    from deckgen.deck import build_cutter_files, cutter_path, fixed_face_boxes
+    from deckgen.packing import ensure_packing, load_packing, specimen_region
     from deckgen.render import render
+
+    if bed not in BEDS:
+        raise SpecError(f"bed: {bed!r} is not one of {', '.join(BEDS)}")
 
     sp = case.specimen
     if not isinstance(sp, CuttingBlock):
         raise SpecError(f"specimen.kind: render_liggghts_cut needs a cutting_block, got {sp.kind} "
                         "(fix: use a cutting case)")
     k = case.kinematics
-    if k.mode == "indentation":
-        raise SpecError("kinematics.mode: indentation is not rendered for LIGGGHTS yet (fix: use linear or oscillation)")
     if not (math.isfinite(cohesion_energy_density) and cohesion_energy_density >= 0):
         raise SpecError("cohesion_energy_density must be a finite number >= 0 J/m^3")
     out = Path(out)
@@ -390,8 +416,16 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     fractions[-1] = 1.0 - sum(fractions[:-1])
     classes = [{"radius": r, "fraction": f, "seed": s} for r, f, s in zip(radii, fractions, seeds)]
 
+    # ---- bed from the case's packing (same grains, shrink and time step as the LAMMPS deck)
+    grains = None
+    if bed == "packing":
+        atoms, packinfo = load_packing(ensure_packing(case, cache, progress=False, command=command))
+        r_bed = atoms.radius * (1.0 - case.bonds.shrink_before_bonding)
+        grains = {"x": atoms.x, "r": r_bed, "r_full_max": float(atoms.radius.max()), "key": packinfo["key"]}
+
     # ---- time step and phases
-    dt = run.timestep_s or contact_timestep(rmin, rho, E_c, nu_c, safety=0.2)
+    r_dt = float(grains["r"].min()) if grains else rmin
+    dt = run.timestep_s or contact_timestep(r_dt, rho, E_c, nu_c, safety=0.2)
     h_fill = FILL_HEIGHT_FACTOR * H
     fill_fraction = min(0.36, 1.15 * 0.60 * H / h_fill)
     g_settle = SETTLE_G_FACTOR * 9.81
@@ -400,7 +434,7 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     settle_steps = _round_up(int(math.ceil(3.0 * t_fall / dt)), run.thermo_every)
     relax_steps = _round_up(int(math.ceil(0.5 * t_fall / dt)), run.thermo_every)
     nsteps = _round_up(int(math.ceil(path["duration"] / dt)), quantum)
-    total = settle_steps + 2 * relax_steps + nsteps
+    total = nsteps if grains else settle_steps + 2 * relax_steps + nsteps
     if total > run.max_steps:
         raise SpecError(f"run.max_steps: the LIGGGHTS cut needs {total} steps at dt {dt:.3g} s "
                         "(fix: raise run.max_steps, shorten kinematics.travel_mm or raise speed_m_s)")
@@ -412,7 +446,19 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     xhi = max(L + pad, path["xc0"] + path["travel"] + R + 2 * e + pad)
     yhi = max(W / 2, half_width) + pad
     zhi = max(h_fill, path["zc0"] + R + 2 * e) + pad
+    if grains:  # no walls: room above for the grains the disc throws up (fixed boundaries lose them)
+        zhi = max(zhi, H + 2.0 * R + pad)
+    if path["rotary_radius"]:  # the curved path drifts toward +y
+        yhi = max(yhi, path["rotary_radius"] * (1 - math.cos(path["travel"] / path["rotary_radius"])) + R + pad)
     box = [xlo, xhi, -yhi, yhi, -pad, zhi]
+    data_file = None
+    fixed_faces: list[dict[str, Any]] = []
+    if grains:
+        data_file = BED_DATA
+        write_granular_data(out / BED_DATA, title=f"deckgen {case.name} packing {grains['key']}", box=box,
+                            radius=grains["r"], density=np.full(len(grains["r"]), rho), x=grains["x"])
+        fixed_faces = fixed_face_boxes(sp, specimen_region(case), 2.0 * grains["r_full_max"],
+                                       3.0 * float(grains["r"].max()))
 
     walls_all = [("zmin", "zplane", 0.0), ("xmin", "xplane", 0.0), ("xmax", "xplane", L),
                  ("ymin", "yplane", -W / 2), ("ymax", "yplane", W / 2)]
@@ -451,6 +497,11 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         _var("x_shaft", path["xc0"] - path["ecc"], "eccentric shaft axis x at t = 0", "m"),
         _var("period_osc", 2 * math.pi / path["omega"] if oscillation else 1.0, "oscillation period", "s"),
         _var("spin_rate", path["spin_rate"], "net spin of the disc about +y", "rad/s"),
+        *([_var("r_rot", path["rotary_radius"], "rotary path radius", "m"),
+           _var("yaw_rate", path["yaw_rate"], "yaw rate of the disc on its circular path (v/r)", "rad/s"),
+           _var("period_yaw", 2 * math.pi / path["yaw_rate"], "period of the yaw rotation", "s"),
+           _var("ax_x", path["axis_x"], "rotary axis x", "m"),
+           _var("ax_y", path["axis_y"], "rotary axis y", "m")] if k.mode == "rotary" else []),
         _var("nsteps", nsteps, "steps of the cut", "steps"),
         _var("thermo_every", run.thermo_every, "thermo interval", "steps"),
         _var("series_every", case.outputs.series_every, "time-series interval", "steps"),
@@ -466,30 +517,138 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
         "seed_pdd": seeds[n_cls], "seed_ins": seeds[n_cls + 1],
         "fill_bounds": [0.0, L, -W / 2, W / 2, 0.0, h_fill],
         "above_bounds": [box[0], box[1], box[2], box[3], H, box[5]],
-        "stl": "cutter.stl", "oscillation": oscillation, "spin_fix": spin_fix,
+        "stl": "cutter.stl", "oscillation": oscillation, "spin_fix": spin_fix, "data_file": data_file,
+        "fixed_faces": fixed_faces, "mesh_dump_every": int(mesh_dump_every), "rotary": k.mode == "rotary",
+        "indent": k.mode == "indentation",
     }
     (out / DECK).write_text(render("liggghts/cut_bed.liggghts.j2", ctx))
     reg = specimen_region(case)
     mean_v = 4.0 / 3.0 * math.pi * float(np.mean(np.asarray(radii) ** 3))
     derived = {
         "engine": "liggghts", "bonded": False, "dt_s": dt, "dt_contact_s": dt,
-        "n_grains": int(round(0.6 * reg.volume_m3 / mean_v)), "n_grains_is_estimate": True,
-        "n_bonds": 0, "specimen_volume_m3": reg.volume_m3, "radius_classes_m": radii,
+        "n_grains": len(grains["r"]) if grains else int(round(0.6 * reg.volume_m3 / mean_v)),
+        "n_grains_is_estimate": not grains, "bed": bed, "packing_key": grains["key"] if grains else None,
+        "n_bonds": 0, "specimen_volume_m3": reg.volume_m3, "radius_classes_m": None if grains else radii,
         "cohesion_energy_density_J_m3": cohesion_energy_density,
-        "settle": {"g_m_s2": g_settle, "fill_height_m": h_fill, "fill_fraction": fill_fraction,
-                   "settle_steps": settle_steps, "relax_steps": relax_steps},
-        "walls_during_cut": sorted(keep),
+        "settle": None if grains else {"g_m_s2": g_settle, "fill_height_m": h_fill, "fill_fraction": fill_fraction,
+                                       "settle_steps": settle_steps, "relax_steps": relax_steps},
+        "walls_during_cut": [] if grains else sorted(keep),
+        "fixed_faces": [f["name"] for f in fixed_faces],
         "cutter": {kk: float(v) for kk, v in path.items()},
         "cutter_summary": {kk: (float(v) if isinstance(v, (int, float, np.floating)) else v)
                            for kk, v in files["summary"].items()},
         "expected_steps": nsteps, "expected_steps_total": total,
         "steady_window": list(case.outputs.steady_window), "kinematics_mode": k.mode,
-        "stacked_moves": ["linear"] + (["rotate_orbit"] if oscillation else []) + (["rotate_spin"] if spin_fix else []),
+        "stacked_moves": (["rotate_yaw"] if k.mode == "rotary" else ["linear"]) + (["rotate_orbit"] if oscillation else [])
+        + (["rotate_spin"] if spin_fix else []),
     }
     spec = {"deckgen_version": __version__, "engine": "liggghts", "case": resolved_dict(case), "derived": derived}
     spec["case"]["engine"] = "liggghts"
     (out / "spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")
     return spec
+
+
+def read_stl_triangles(path: str | Path) -> np.ndarray:
+    """Triangles (n, 3, 3) [m] of an ASCII STL (``dump mesh/stl`` output), streamed line by line."""
+    from deckgen.parse.common import ParseError, open_text
+
+    path = Path(path)
+    verts: list[list[float]] = []
+    with open_text(path) as fh:
+        for lineno, line in enumerate(fh, 1):
+            w = line.split()
+            if w and w[0] == "vertex":
+                try:
+                    verts.append([float(w[1]), float(w[2]), float(w[3])])
+                except (IndexError, ValueError):
+                    raise ParseError(path, lineno, "bad vertex line") from None
+    if len(verts) % 3:
+        raise ParseError(path, 0, f"{len(verts)} vertices: not whole triangles")
+    return np.asarray(verts, dtype=float).reshape(-1, 3, 3)
+
+
+def rigid_cutter_position(p0: np.ndarray, path: Mapping[str, float], t: float) -> np.ndarray:
+    """Where points ``p0`` of the disc at rest (centre at the origin, axis y) are at cut time ``t``:
+    centre x_c = x_c0 + V t + e (cos wt - 1), z_c = z_c0 + e sin wt, spin th = spin_rate t about +y
+    (x' = x cos th + z sin th, z' = -x sin th + z cos th, as the LAMMPS cutting deck)."""
+    V, e, w, s = path["V"], path["ecc"], path["omega"], path["spin_rate"]
+    th = s * t
+    x, y, z = p0[..., 0], p0[..., 1], p0[..., 2]
+    spun = np.stack([x * math.cos(th) + z * math.sin(th), y, -x * math.sin(th) + z * math.cos(th)], axis=-1)
+    if path.get("rotary_radius", 0.0):  # p = A + Rz(phi) [(c0 - A) + Ry(th) p0], phi = yaw_rate t
+        phi = path["yaw_rate"] * t
+        q = spun + np.array([path["xc0"] - path["axis_x"], path["yc0"] - path["axis_y"], 0.0])
+        rot = np.stack([q[..., 0] * math.cos(phi) - q[..., 1] * math.sin(phi),
+                        q[..., 0] * math.sin(phi) + q[..., 1] * math.cos(phi), q[..., 2]], axis=-1)
+        return rot + np.array([path["axis_x"], path["axis_y"], path["zc0"]])
+    if path.get("mode_indent", 0.0):
+        return spun + np.array([path["xc0"], path["yc0"], path["zc0"] - V * t])
+    c = np.array([path["xc0"] + V * t + e * (math.cos(w * t) - 1.0), path["yc0"], path["zc0"] + e * math.sin(w * t)])
+    return spun + c
+
+
+def render_liggghts(case: Case, out: str | Path, *, bed: str = "packing", cache: Path | None = None,
+                    command: list[str] | None = None) -> dict[str, Any]:
+    """Render any case for LIGGGHTS, or refuse it in one line (:class:`SpecError`) saying what to change.
+
+    cutting + ``bonds.enabled: false``: :func:`render_liggghts_cut` (``bed`` packing or settle);
+    ucs / bts with bonds: :func:`render_liggghts_ucs_bonded` / :func:`render_liggghts_bts_bonded`
+    (Flexible_Fibers fork).
+    """
+    bonded = case.bonds.enabled
+    if case.test == "cutting":
+        if bonded:
+            raise SpecError(f"case {case.name}: engine liggghts renders unbonded cutting beds only (a bonded cutting block "
+                            "for the bond/gran fork is not written yet) (fix: bonds.enabled: false, or engine: lammps)")
+        return render_liggghts_cut(case, out, bed=bed, cache=cache, command=command)
+    if not bonded:
+        raise SpecError(f"case {case.name}: engine liggghts renders {case.test} specimens bonded only "
+                        "(fix: bonds.enabled: true, or engine: lammps)")
+    if case.test == "ucs":
+        return render_liggghts_ucs_bonded(case, out)
+    return render_liggghts_bts_bonded(case, out)
+
+
+#: summary quantities compared by :func:`cross_engine_cut` (cutter frame, steady window)
+CROSS_QUANTITIES = ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
+                    "contact_fraction_steady_1")
+
+
+def cross_engine_cut(case: Case, out: str | Path, *, cache: Path | None = None, ranks: int = 1,
+                     timeout_s: float | None = 1800) -> dict[str, Any]:
+    """Cut the same unbonded bed with the same disc and motion on LAMMPS and on LIGGGHTS.
+
+    The case must have ``bonds.enabled: false``. LAMMPS: :func:`deckgen.deck.render_case` (the
+    case's packing, radii shrunk by ``shrink_before_bonding``, no bond, cutter = rigid shell of
+    spheres on the STL offset inward by their radius). LIGGGHTS: :func:`render_liggghts_cut` with
+    ``bed="packing"`` (the same grains from the same packing, the same fixed faces, time step and
+    motion, no gravity; cutter = the STL mesh itself). Both runs are parsed with
+    :func:`deckgen.results.parse_run`; returns ``{"lammps": {...}, "liggghts": {...}, "ratio":
+    {q: liggghts / lammps}}`` for :data:`CROSS_QUANTITIES`, plus the folders.
+    """
+    from deckgen.deck import render_case
+    from deckgen.results import parse_run
+    from deckgen.runner import engine_command, run_deck
+
+    if case.test != "cutting" or case.bonds.enabled:
+        raise SpecError(f"case {case.name}: the cross-engine check needs a cutting case with bonds.enabled: false")
+    out = Path(out)
+    lmp_cmd = engine_command(ranks)
+    res: dict[str, Any] = {}
+    for eng in ("lammps", "liggghts"):
+        d = out / eng
+        c = case.model_copy(update={"engine": eng})
+        if eng == "lammps":
+            render_case(c, d, cache=cache, progress=False, command=lmp_cmd)
+            run_deck(d, "in.deck", command=lmp_cmd, progress=False, timeout_s=timeout_s, label=f"lammps {case.name}")
+        else:
+            render_liggghts_cut(c, d, bed="packing", cache=cache, command=lmp_cmd)
+            run_liggghts(d, ranks=ranks, timeout_s=timeout_s)
+        s = parse_run(d, d / "parsed")
+        res[eng] = {q: s[q] for q in CROSS_QUANTITIES} | {"n_grains": s["n_grains"], "dir": str(d)}
+    res["ratio"] = {q: (res["liggghts"][q] / res["lammps"][q] if res["lammps"][q] else float("nan"))
+                    for q in CROSS_QUANTITIES}
+    return res
 
 
 # =============================================================================== bond/gran (fork)
@@ -676,19 +835,44 @@ def _platen_stl(path: Path, radius: float, z: float, thickness: float, down: boo
 def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     """Render a bonded UCS deck for the Flexible_Fibers fork (golden-tested and grammar-checked only).
 
-    Grains are inserted into the cylinder and settled on the bottom platen by LIGGGHTS, bonded
+    Grains are inserted into the cylinder and settled on the bottom platen by LIGGGHTS, trimmed
+    to the height (centres above H - r_max deleted; the top platen mesh is placed only then), bonded
     once with ``fix bond/create/gran`` (cutoff (1 + gap_tolerance) x the mean grain diameter: the
     fork's bond creation has one cutoff, it is not radius-aware), then loaded by the top platen.
     """
+    if not isinstance(case.specimen, UcsCylinder):
+        raise SpecError(f"specimen.kind: render_liggghts_ucs_bonded needs ucs_cylinder, got {case.specimen.kind}")
+    return _render_platen_bonded(case, out)
+
+
+def render_liggghts_bts_bonded(case: Case, out: str | Path) -> dict[str, Any]:
+    """Render a bonded Brazilian test deck for the Flexible_Fibers fork (golden-tested and grammar-checked only).
+
+    The disc (axis y, centre (0, R) in x-z, as :func:`deckgen.packing.specimen_region`) is made by
+    insertion and settling in a box 2R wide between y walls, trimmed to the disc (grains with their
+    centre above 2R - r_max or farther than R - r_max from the axis are deleted, so no grain crosses
+    the platens), bonded once as the UCS deck, and loaded across its diameter by flat platen meshes
+    (bottom at z = 0, top at z = 2R moving down). Stress = F / (pi D t / 2) (the Brazilian tensile
+    stress 2F/(pi D t), as the LAMMPS deck); strain = platen displacement / D.
+    """
+    if not isinstance(case.specimen, BrazilianDisc):
+        raise SpecError(f"specimen.kind: render_liggghts_bts_bonded needs brazilian_disc, got {case.specimen.kind}")
+    return _render_platen_bonded(case, out)
+
+
+def _render_platen_bonded(case: Case, out: str | Path) -> dict[str, Any]:
+    """The bonded platen decks (UCS cylinder, Brazilian disc) for the Flexible_Fibers fork."""
     from deckgen.render import render
 
     sp = case.specimen
-    if not isinstance(sp, UcsCylinder):
-        raise SpecError(f"specimen.kind: render_liggghts_ucs_bonded needs ucs_cylinder, got {sp.kind}")
+    bts = isinstance(sp, BrazilianDisc)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     b, c, p, run = case.bonds, case.contact, case.packing, case.run
-    Rc, Hc = sp.diameter_mm * MM / 2, sp.height_mm * MM
+    if bts:
+        Rc, Hc, thick = sp.diameter_mm * MM / 2, sp.diameter_mm * MM, sp.thickness_mm * MM
+    else:
+        Rc, Hc = sp.diameter_mm * MM / 2, sp.height_mm * MM
     rmin, rmax = p.radius_min_mm * MM, p.radius_max_mm * MM
     rho = case.material.density_kg_m3 * run.mass_scaling
     E_b = b.youngs_modulus_GPa * GPA
@@ -724,6 +908,10 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     nsteps = _round_up(int(math.ceil(sp.max_strain * Hc / v / dt)), case.outputs.series_every)
     margin = 2 * rmax + 6 * skin      # every grain stays > skin away from the box faces
     box = [-Rc - margin, Rc + margin, -Rc - margin, Rc + margin, -margin, fill_h + margin]
+    area = math.pi * Rc**2
+    if bts:
+        box[2:4] = [-thick / 2 - margin, thick / 2 + margin]
+        area = math.pi * (2 * Rc) * thick / 2.0  # sigma_t = F / area = 2F/(pi D t)
     _platen_stl(out / "platen_bottom.stl", Rc, 0.0, 2 * rmax, down=True)
     _platen_stl(out / "platen_top.stl", Rc, Hc, 2 * rmax, down=False)
     per_atom = 16
@@ -748,7 +936,11 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
         _var("settle_steps", settle_steps, "settling run", "steps"),
         _var("bond_cutoff", (1 + b.gap_tolerance) * (rmin + rmax), "bond creation cutoff (centre distance)", "m"),
         _var("v_platen", v, "top platen speed (down)", "m/s"),
-        _var("area", math.pi * Rc**2, "stress area pi R^2", "m^2"),
+        _var("area", area, "stress area (UCS pi R^2, BTS pi D t / 2)", "m^2") if bts else
+        _var("area", area, "stress area pi R^2", "m^2"),
+        *([_var("thickness", thick, "disc thickness (y)", "m"),
+           _var("trim_radius", Rc - rmax, "grains with their centre farther from the disc axis are deleted", "m")]
+          if bts else []),
         _var("nsteps", nsteps, "loading steps (max strain)", "steps"),
         _var("thermo_every", run.thermo_every, "thermo interval", "steps"),
         _var("series_every", case.outputs.series_every, "time-series interval", "steps"),
@@ -756,20 +948,31 @@ def render_liggghts_ucs_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     rolling = c.rolling_friction > 0
     ctx = {
         "version": __version__, "case_name": case.name, "test": case.test, "deck_name": DECK,
-        "title": "uniaxial compression of a bonded cylinder (bond/gran fork)", "template": "ucs_bonded.liggghts.j2",
+        "title": "Brazilian test of a bonded disc (bond/gran fork)" if bts else
+        "uniaxial compression of a bonded cylinder (bond/gran fork)",
+        "template": "bts_bonded.liggghts.j2" if bts else "ucs_bonded.liggghts.j2",
         "variables": variables, "hard_particles": True, "box": box, "n_atom_types": 2,
         "atom_style": ["hybrid", "granular", "bond/gran", "n_bondtypes", 1, "bonds_per_atom", per_atom,
                        "disableNormalContact", 1],
         "rolling": rolling, "cohesion": False, "contact_model": contact_model(rolling, False), "bond": bond,
         "bonds_per_atom": per_atom, "radius_classes": classes, "n_classes": n_cls, "seed_pdd": seeds[n_cls],
         "seed_ins": seeds[n_cls + 1], "platen_bottom": "platen_bottom.stl", "platen_top": "platen_top.stl",
+        "above_bounds": [box[0], box[1], box[2], box[3], Hc - rmax, box[5]],
     }
-    text = render("liggghts/ucs_bonded.liggghts.j2", ctx)
+    if bts:
+        ctx.update({
+            "fill_bounds": [-Rc, Rc, -thick / 2, thick / 2, 0.0, fill_h],
+            "mould_walls": [{"id": f"w_{n}", "plane": pl, "position": pos} for n, pl, pos in
+                            (("xmin", "xplane", -Rc), ("xmax", "xplane", Rc), ("ymin", "yplane", -thick / 2),
+                             ("ymax", "yplane", thick / 2))],
+            "trim_y": [box[2], box[3]],
+        })
+    text = render("liggghts/" + ctx["template"], ctx)
     check_bonded_deck(text)
     (out / DECK).write_text(text)
     derived = {"engine": "liggghts", "bonded": True, "dt_s": dt, "bond_gran": bond, "n_bonds": 0,
-               "n_grains": 0, "expected_steps": nsteps, "expected_steps_total": settle_steps + 1 + nsteps,
-               "height_m": Hc, "area_m2": math.pi * Rc**2, "platen_speed_m_s": v}
+               "n_grains": 0, "expected_steps": nsteps, "expected_steps_total": settle_steps + run.thermo_every + 1 + nsteps,
+               "height_m": Hc, "area_m2": area, "platen_speed_m_s": v}
     spec = {"deckgen_version": __version__, "engine": "liggghts", "case": resolved_dict(case), "derived": derived}
     spec["case"]["engine"] = "liggghts"
     (out / "spec.json").write_text(json.dumps(spec, indent=2, sort_keys=True) + "\n")

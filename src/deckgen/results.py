@@ -792,7 +792,7 @@ def aggregate(parsed_dirs: Iterable[str | Path], tables_dir: str | Path) -> dict
     cumulative bonds_broken and by mode). Returns {name: parquet path}.
     """
     tables_dir = Path(tables_dir)
-    seen: dict[str, Path] = {}
+    seen: dict[tuple[str, str], Path] = {}
     forces_ts: list[pd.DataFrame] = []
     platen_ts: list[pd.DataFrame] = []
     broken_ts: list[pd.DataFrame] = []
@@ -802,9 +802,10 @@ def aggregate(parsed_dirs: Iterable[str | Path], tables_dir: str | Path) -> dict
     for d in map(Path, parsed_dirs):
         s = _load_summary(d)
         case, engine, test = s["case"], s["engine"], s["test"]
-        if case in seen:
-            raise ValueError(f"{d}: case {case!r} also parsed in {seen[case]} (one folder per case)")
-        seen[case] = d
+        if (case, engine) in seen:  # the same case may run on both engines (cross-engine checks)
+            raise ValueError(f"{d}: case {case!r} on {engine} also parsed in {seen[case, engine]} "
+                             "(one folder per case and engine)")
+        seen[case, engine] = d
         ts = read_table(d / "timeseries")
         ts.insert(0, "engine", engine)
         ts.insert(0, "case", case)

@@ -108,6 +108,11 @@ class Bonds(_Model):
     damping_ratio: float = _f(0.05, "1", "Bond damping as a fraction of critical (normal, shear, roll, twist).", ge=0, le=2)
     type_bins_radius: int = _f(6, "1", "Bond types: bins of bond radius.", ge=1, le=20)
     type_bins_length: int = _f(4, "1", "Bond types: bins of bond length.", ge=1, le=20)
+    enabled: bool = Field(
+        True, description="False: an unbonded granular specimen (the same packing and radius shrink, no bond; "
+        "cross-engine checks). Written to spec.json only when false.",
+        json_schema_extra={"unit": "1"}, exclude_if=lambda v: v is True,
+    )
 
 
 # --------------------------------------------------------------------------- contact

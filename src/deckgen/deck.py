@@ -34,12 +34,6 @@ DATA = "specimen.data"
 SHELL_DENSITY = 7850.0 * 1000.0  # cutter shell spheres: heavy, so contact m_eff ~ grain mass
 
 
-def tsuji_alpha(e: float) -> float:
-    """Tsuji et al. (1992) damping coefficient for restitution e (as in LAMMPS pair granular docs)."""
-    return (1.2728 - 4.2783 * e + 11.087 * e**2 - 22.348 * e**3 + 27.467 * e**4
-            - 18.022 * e**5 + 4.8218 * e**6)
-
-
 def effective_modulus(E1: float, nu1: float, E2: float, nu2: float, nu_deck: float) -> float:
     """E to give ``hertz/material`` for an i-j pair of different materials.
 
@@ -273,7 +267,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         _var("rho", rho, "grain density (x mass scaling)", "kg/m^3"),
         _var("E_c", E_c, "grain Young's modulus, Hertz contact", "Pa"),
         _var("nu_c", nu_c, "grain Poisson's ratio", "1"),
-        _var("damp_alpha", tsuji_alpha(c.restitution), "Tsuji damping for restitution %.3g" % c.restitution, "1"),
+        _var("e_rest", c.restitution, "restitution (damping tsuji maps it to the Tsuji et al. 1992 coefficient)", "1"),
         _var("mu_c", c.friction, "grain-grain sliding friction", "1"),
         _var("mu_roll", c.rolling_friction, "grain-grain rolling friction (SDS)", "1"),
         _var("k_roll", k_roll, "rolling stiffness (Hertz stiffness at 0.5 pct overlap)", "N/m"),

@@ -5,11 +5,13 @@ worker processes). File names are ``<case>_<kind>.png``:
 
 platen tests (UCS, BTS)
     ``stress_strain`` (stress in MPa over strain in %, peak marked, modulus fit window and line),
-    ``broken_bonds`` (cumulative broken bonds over time, by failure mode).
+    ``broken_bonds`` (cumulative broken bonds over time, by failure mode),
+    ``damage`` (failure pattern: grains coloured by broken/initial bonds, x-z plane).
 cutting
     ``forces_time`` (normal, rolling and side force over time; steady window shaded, its means
     as dashed lines), ``forces_x`` (the same over the cutter x position; over the penetration for
-    indentation: ``forces_penetration``), ``broken_bonds`` (cumulative, by failure mode).
+    indentation: ``forces_penetration``), ``broken_bonds`` (cumulative, by failure mode),
+    ``damage`` (x-z slice through y = 0, grains coloured by damage).
 """
 
 from __future__ import annotations
@@ -145,6 +147,36 @@ def _forces_x(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
     return _save(fig, path)
 
 
+def _damage_snapshot(summary: dict[str, Any], dmg: pd.DataFrame, path: Path) -> Path | None:
+    """Failure pattern: grains of the final frame as circles (true size) coloured by their damage
+    ratio (broken / initial bonds), in the x-z plane: the whole Brazilian disc (its axis is y), a
+    slice |y| < 1.5 r_max through the axis of a UCS cylinder or through y = 0 of a cutting block."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+
+    d = dmg[np.isfinite(dmg["damage_ratio_1"].to_numpy(dtype=float))]
+    if d.empty:
+        return None
+    if summary["test"] != "bts":
+        d = d[np.abs(d["y_m"].to_numpy()) < 1.5 * float(d["radius_m"].max())]
+    fig = Figure(figsize=(4.5 if summary["test"] == "ucs" else 6.5, 6.0), dpi=120, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    circles = [Circle((x * 1e3, z * 1e3), r * 1e3) for x, z, r in zip(d["x_m"], d["z_m"], d["radius_m"])]
+    pc = PatchCollection(circles, cmap="inferno_r", edgecolor="0.4", linewidth=0.2)
+    pc.set_array(d["damage_ratio_1"].to_numpy(dtype=float))
+    pc.set_clim(0.0, 1.0)
+    ax.add_collection(pc)
+    ax.autoscale_view()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("z (mm)")
+    fig.colorbar(pc, ax=ax, label="damage: broken / initial bonds", shrink=0.8)
+    what = "failure pattern (x-z, whole disc)" if summary["test"] == "bts" else "failure pattern (x-z slice through y = 0)"
+    ax.set_title(_title(summary, what), fontsize="small")
+    return _save(fig, path)
+
+
 def plot_run(parsed_dir: str | Path, plots_dir: str | Path) -> list[Path]:
     """Write the PNG plots of one parsed run into ``plots_dir``; return their paths."""
     parsed_dir = Path(parsed_dir)
@@ -164,4 +196,8 @@ def plot_run(parsed_dir: str | Path, plots_dir: str | Path) -> list[Path]:
         kind = "forces_penetration" if summary.get("kinematics_mode") == "indentation" else "forces_x"
         out.append(_forces_x(summary, ts, plots_dir / f"{case}_{kind}.png"))
     out.append(_broken_plot(summary, bt, plots_dir / f"{case}_broken_bonds.png"))
+    if (parsed_dir / "damage.parquet").is_file() or (parsed_dir / "damage.csv").is_file():
+        snap = _damage_snapshot(summary, read_table(parsed_dir / "damage"), plots_dir / f"{case}_damage.png")
+        if snap is not None:
+            out.append(snap)
     return out

@@ -328,7 +328,8 @@ PARAMS: dict[str, ParamDef] = {
     "radius_multiplier": ParamDef("radius_multiplier", 0.5, 2.0, lambda p: p.radius_multiplier,
                                   lambda d, v: d.__setitem__("radius_multiplier", v)),
     # interaction range: grains within gap <= g * min(r1, r2) are bonded (Scholtes & Donze 2013)
-    "gap_tolerance": ParamDef("gap_tolerance", 0.0, 1.0, lambda p: p.gap_tolerance,
+    # bounded to the rising branch of UCS/BTS(g) (measured peak near 0.4-0.6; BTS climbs steeply beyond)
+    "gap_tolerance": ParamDef("gap_tolerance", 0.0, 0.5, lambda p: p.gap_tolerance,
                               lambda d, v: d.__setitem__("gap_tolerance", v)),
 }
 
@@ -422,9 +423,10 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
                    space: ParameterSpace | None = None) -> MicroParams:
     """Start micro-parameters from the measured micro-macro table (:func:`micro_macro`).
 
-    The ratio UCS/BTS fixes the ratio knob(s): with ``gap_tolerance`` in ``space``, g (in
-    [0, GAP_START_MAX]) at tau_c/sigma_c = 1 that comes closest, and if ``log_tau_ratio`` is also
-    free, tau_c/sigma_c closes the rest; without it, tau_c/sigma_c at the base case's g. Then
+    The ratio UCS/BTS fixes the ratio knob(s): with ``gap_tolerance`` in ``space``, g on the rising
+    branch (up to GAP_START_MAX and the bound) at tau_c/sigma_c = 1 that comes closest; when that
+    falls short of the ratio (or ``log_tau_ratio`` is free too), tau_c/sigma_c closes the rest and
+    (if not free) stays there; without g, tau_c/sigma_c at the base case's g. Then
     E_b = E / (E/E_b) and sigma_c = BTS / (BTS/sigma_c). Friction, rolling friction and the bond
     radius multiplier come from the base case. Values are clipped into the bounds of ``space``.
     """
@@ -452,11 +454,13 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         return math.exp(brentq(f, lo, hi, xtol=1e-9))
 
     if "gap_tolerance" in sp.names:
-        grid = np.linspace(0.0, GAP_START_MAX, 161)
+        hi = min(GAP_START_MAX, float(sp.hi[sp.names.index("gap_tolerance")]))
+        grid = np.linspace(0.0, hi, 161)
         lr = np.array([log_ratio(x, TAU_RATIO_START) for x in grid])
         rising = grid[: int(np.argmax(lr)) + 1]  # the rising branch: the fewest extra bonds for the ratio
         g = float(rising[np.argmin(np.abs(lr[: len(rising)] - want))])
-        r = solve_r(g) if "log_tau_ratio" in sp.names else TAU_RATIO_START
+        # beyond the highest ratio g gives, a lower tau_c/sigma_c closes the rest (free or fixed at the start)
+        r = solve_r(g) if ("log_tau_ratio" in sp.names or want > lr.max()) else TAU_RATIO_START
     else:
         g = base.bonds.gap_tolerance
         r = solve_r(g)
@@ -759,7 +763,7 @@ class _Stop(Exception):
 
 TABLE_COLUMNS = [
     "eval", "key", "ok", "error", "youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa", "friction",
-    "rolling_friction", "radius_multiplier", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1", "bts_error_1", "E_error_1",
+    "rolling_friction", "radius_multiplier", "gap_tolerance", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1", "bts_error_1", "E_error_1",
     "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]
 
@@ -888,7 +892,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
         if ev.ok:
             e = ev.rel_errors(t)
             log(f"eval {ev.index:3d}{' (replayed)' if ev.replayed else ''}: E_b {p.youngs_modulus_GPa:.4g} GPa, "
-                f"sigma_c {p.tensile_strength_MPa:.4g} MPa, tau_c {p.shear_strength_MPa:.4g} MPa -> "
+                f"sigma_c {p.tensile_strength_MPa:.4g} MPa, tau_c {p.shear_strength_MPa:.4g} MPa, g {p.gap_tolerance:.3g} -> "
                 f"UCS {ev.ucs_Pa / MPA:.4g} MPa ({e[0]:+.1%}), BTS {ev.bts_Pa / MPA:.4g} MPa ({e[1]:+.1%}), "
                 f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%})")
             if np.all(np.abs(e) <= tol):

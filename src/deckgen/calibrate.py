@@ -59,6 +59,8 @@ from deckgen.spec import TOKEN_RE, Bonds, Case, Contact, SpecError, deep_merge, 
 
 GPA, MPA = 1e9, 1e6
 OUTPUTS = ("ucs", "bts", "E")
+#: Replicate packings of an evaluation use packing seeds base + i * this (a prime).
+REPLICATE_SEED_STEP = 7919
 #: Residual (log-error) given to each output of a failed point: a factor e^5 ~ 150 off.
 FAIL_RESIDUAL = 5.0
 
@@ -116,6 +118,9 @@ class CalibrationSetup(_Model):
             "Quasi-static loading: platen speeds (where a specimen block does not set platen_speed_m_s) are "
             "chosen so that the time to the expected peak holds this many P-wave transits of the specimen: "
             "v = eps_peak * sqrt(E/rho) / N with eps_peak = UCS/E (UCS) or 8 BTS/E (BTS)."))
+    ucs_packings: int = Field(1, ge=1, le=10, description="UCS tests per evaluation (packing seeds), averaged.")
+    bts_packings: int = Field(3, ge=1, le=10, description=(
+        "BTS tests per evaluation (packing seeds), averaged: a coarse Brazilian disc scatters ~12 % over packings."))
     ucs_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_UCS), description="UCS specimen block.")
     bts_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_BTS), description="BTS specimen block.")
 
@@ -601,8 +606,11 @@ class DemEvaluator:
     def __init__(self, base: dict[str, Any], ucs_specimen: dict[str, Any], bts_specimen: dict[str, Any],
                  work_dir: str | Path, *, cache: str | Path | None = None, command: list[str] | None = None,
                  tie_contact_modulus: bool = True, timeout_s: float | None = None, name: str = "cal",
-                 parallel: bool = False) -> None:
+                 parallel: bool = False, ucs_packings: int = 1, bts_packings: int = 1) -> None:
         self.base = base
+        # replicate packings per test: the point's value is their mean (packing scatter of a coarse
+        # Brazilian disc is ~12 %, more than the tolerance; docs/calibration.md)
+        self.replicates = {"ucs": int(ucs_packings), "bts": int(bts_packings)}
         self.parallel = parallel  # run the UCS and the BTS test at the same time (give each a 1-rank command)
         self.ucs_specimen, self.bts_specimen = dict(ucs_specimen), dict(bts_specimen)
         self.work_dir = Path(work_dir)
@@ -622,11 +630,15 @@ class DemEvaluator:
         """Run folder of a point: ``work_dir/<setup key>/<params key>``."""
         return self.work_dir / self.setup_key / params.key()
 
-    def case(self, params: MicroParams, test: Literal["ucs", "bts"]) -> Case:
+    def case(self, params: MicroParams, test: Literal["ucs", "bts"], replicate: int = 0) -> Case:
         sp = self.ucs_specimen if test == "ucs" else self.bts_specimen
         data = deep_merge(deep_merge(self.base, params.overrides(self.tie)), {"specimen": sp})
         data = deep_merge({"name": f"{self.name}-{test}"}, data)
-        return Case.model_validate(data)
+        case = Case.model_validate(data)
+        if replicate:
+            seed = (case.packing.seed + REPLICATE_SEED_STEP * replicate) % (2**31 - 1) or 1
+            case = Case.model_validate(deep_merge(data, {"packing": {"seed": seed}}))
+        return case
 
     def describe(self) -> dict[str, Any]:
         if self._engine is None:
@@ -636,20 +648,22 @@ class DemEvaluator:
                 "radius_min_mm": base.packing.radius_min_mm, "radius_max_mm": base.packing.radius_max_mm,
                 "ucs_specimen": self.ucs_specimen, "bts_specimen": self.bts_specimen}
 
-    def _one(self, params: MicroParams, test: Literal["ucs", "bts"], folder: Path) -> dict[str, Any]:
+    def _one(self, params: MicroParams, test: Literal["ucs", "bts"], folder: Path, replicate: int = 0) -> dict[str, Any]:
         from deckgen.deck import render_case
         from deckgen.results import parse_run
         from deckgen.runner import run_deck
 
-        summary = folder / test / "parsed" / "summary.json"
+        sub = folder / (test if replicate == 0 else f"{test}_r{replicate}")
+        summary = sub / "parsed" / "summary.json"
         if summary.is_file():
             return json.loads(summary.read_text())
-        run_dir = folder / test / "run"
-        spec = render_case(self.case(params, test), run_dir, cache=self.cache, progress=False, command=self.command)
+        run_dir = sub / "run"
+        spec = render_case(self.case(params, test, replicate), run_dir, cache=self.cache, progress=False,
+                           command=self.command)
         self.engine_runs += 1
         run_deck(run_dir, expected_steps=spec["derived"]["expected_steps"], command=self.command,
                  progress=False, timeout_s=self.timeout_s)
-        return parse_run(run_dir, folder / test / "parsed")
+        return parse_run(run_dir, sub / "parsed")
 
     def evaluate(self, params: MicroParams) -> dict[str, Any]:
         from deckgen.parse import ParseError
@@ -665,17 +679,22 @@ class DemEvaluator:
         runs0 = self.engine_runs
         t0 = time.perf_counter()
         try:
+            jobs = [(t, i) for t in ("ucs", "bts") for i in range(self.replicates[t])]
             if self.parallel:
                 from concurrent.futures import ThreadPoolExecutor
 
                 with ThreadPoolExecutor(max_workers=2) as pool:
-                    fu, fb = pool.submit(self._one, params, "ucs", folder), pool.submit(self._one, params, "bts", folder)
-                    ucs, bts = fu.result(), fb.result()
+                    futures = [pool.submit(self._one, params, t, folder, i) for t, i in jobs]
+                    done = [f.result() for f in futures]
             else:
-                ucs = self._one(params, "ucs", folder)
-                bts = self._one(params, "bts", folder)
-            out = {"ucs_Pa": _num(ucs.get("peak_stress_Pa")), "bts_Pa": _num(bts.get("peak_stress_Pa")),
-                   "E_Pa": _num(ucs.get("youngs_modulus_Pa")), "ok": True, "error": ""}
+                done = [self._one(params, t, folder, i) for t, i in jobs]
+            ucs = [d for (t, _), d in zip(jobs, done) if t == "ucs"]
+            bts = [d for (t, _), d in zip(jobs, done) if t == "bts"]
+            mean = lambda runs, k: float(np.mean([_num(r.get(k)) for r in runs]))  # noqa: E731
+            out = {"ucs_Pa": mean(ucs, "peak_stress_Pa"), "bts_Pa": mean(bts, "peak_stress_Pa"),
+                   "E_Pa": mean(ucs, "youngs_modulus_Pa"), "ok": True, "error": ""}
+            if len(bts) > 1:
+                out["bts_cv_1"] = float(np.std([_num(r.get("peak_stress_Pa")) for r in bts], ddof=1) / out["bts_Pa"])
             bad = [k for k in ("ucs_Pa", "bts_Pa", "E_Pa") if not (math.isfinite(out[k]) and out[k] > 0)]
             if bad:
                 out.update(ok=False, error=f"non-finite or non-positive {', '.join(bad)} ({folder})")
@@ -1038,7 +1057,8 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
         ucs, bts = quasi_static_specimens(card)
         evaluator = DemEvaluator(base, ucs, bts, out / "work", cache=cache,
                                  command=command, tie_contact_modulus=setup.tie_contact_modulus, name=card.rock,
-                                 parallel=parallel)
+                                 parallel=parallel, ucs_packings=setup.ucs_packings,
+                                 bts_packings=setup.bts_packings)
     log = (lambda s: None) if quiet else (lambda s: print(s, flush=True))
     log(f"{card.rock}: start E_b {start.youngs_modulus_GPa:.4g} GPa, sigma_c {start.tensile_strength_MPa:.4g} MPa, "
         f"tau_c {start.shear_strength_MPa:.4g} MPa; parameters {space.names}")

@@ -235,3 +235,40 @@ def test_cli_gap_bad_files(tmp_path, capsys):
     assert "--backend fem: unknown backend (fix: use fast or dem)" in err
     err = _err(capsys, ["gap", "--measured", str(mp), "--base", str(BASE), "--out", str(tmp_path), "--candidates", "magic"])
     assert "unknown effect(s) magic" in err
+
+
+# --------------------------------------------------------------------------- DEM deck switches
+def test_dem_switches_change_the_deck(tmp_path):
+    """wear flat and tilt change the cutter STL, neighbour spacing removes the neighbours' grooves from the
+    block, confinement loads the free side face with s3 * L * H; the default deck has none of them."""
+    import importlib.util
+
+    import trimesh
+
+    from deckgen.deck import render_case
+    from deckgen.spec import MM
+
+    spec_ = importlib.util.spec_from_file_location("regen", ROOT / "tests" / "data" / "golden" / "regenerate.py")
+    regen = importlib.util.module_from_spec(spec_)
+    spec_.loader.exec_module(regen)
+    case0 = load_case(ROOT / "tests" / "data" / "cases" / "tiny_cut.yaml")
+    over = {"cutter": {"wear_flat_mm": 0.8, "tilt_deg": 6.0}, "specimen": {"kind": "cutting_block", "confining_stress_MPa": 4.0},
+            "kinematics": {"neighbour_spacing_mm": 3.5}}
+    case1 = load_case(ROOT / "tests" / "data" / "cases" / "tiny_cut.yaml", over)
+    regen.install_fixture(case0, "tiny_cut", tmp_path / "cache")
+    s0 = render_case(case0, tmp_path / "r0", cache=tmp_path / "cache", progress=False, command=["false"])
+    s1 = render_case(case1, tmp_path / "r1", cache=tmp_path / "cache", progress=False, command=["false"])
+    d0, d1 = s0["derived"], s1["derived"]
+    removed = d1["neighbour_groove_grains_removed"]
+    assert removed > 0 and d1["n_grains"] == d0["n_grains"] - removed
+    assert d1["cutter_summary"]["diameter_m"] < d0["cutter_summary"]["diameter_m"] - 0.5 * MM
+    m = trimesh.load(tmp_path / "r1" / "cutter.stl")
+    low = m.vertices[np.argmin(m.vertices[:, 2])]
+    assert low[1] > 0.1 * MM  # the tilted rim leans toward +y (lowest point: an edge of the 0.8 mm land)
+    deck0, deck1 = (tmp_path / "r0" / "in.deck").read_text(), (tmp_path / "r1" / "in.deck").read_text()
+    assert "addforce" not in deck0
+    lines = [ln for ln in deck1.splitlines() if ln.startswith("fix") and "addforce" in ln]
+    assert len(lines) == 1 and "confine_ymax" in lines[0]  # y min is a fixed face of tiny_cut
+    n = int(next(ln for ln in deck1.splitlines() if ln.startswith("# confining stress")).split(": ")[1].split()[0])
+    f = float(lines[0].split()[5])
+    assert n * f == pytest.approx(-4.0e6 * 16e-3 * 8e-3, rel=1e-6)

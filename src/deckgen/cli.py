@@ -183,7 +183,7 @@ def cmd_gap(args: argparse.Namespace) -> int:
     if args.noise_cv is not None and not (0 < args.noise_cv < 1):
         raise SpecError(f"--noise-cv {args.noise_cv:g}: must lie in (0, 1) (fix: e.g. 0.05 for 5 % scatter)")
     rep = gap(args.measured, args.base, args.out, backend=args.backend, candidates=cands, noise_cv=args.noise_cv,
-              command=_command(args), cache=_cache(args))
+              command=_command(args), cache=_cache(args), runs=Path(args.runs) if args.runs else None)
     print(f"{args.measured}: {rep['cases']} cases, {rep['rows']} rows, backend {rep['backend']}: "
           f"named effect {rep['named_effect'] or 'none'} ({rep['verdict']})")
     print(f"  {rep['reason']}")
@@ -252,6 +252,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--backend", default="fast", help="fast (reduced model, seconds) or dem (LAMMPS decks)")
     s.add_argument("--candidates", help="comma-separated catalogue ids to consider (default: all)")
     s.add_argument("--noise-cv", type=float, help="relative scatter to assume when there are no replicates")
+    s.add_argument("--runs", help="dem backend: folder of the (cached) runs (default: OUT/dem_runs)")
     engine_opts(s)
     s.set_defaults(func=cmd_gap)
     return p

@@ -77,9 +77,10 @@ class DemBackend:
         return pd.DataFrame(rows, index=cases.index, columns=list(RESPONSE_COLUMNS))
 
 
-def make_backend(name: str, out: Path, *, command: list[str] | None = None, cache: Path | None = None):
+def make_backend(name: str, out: Path, *, command: list[str] | None = None, cache: Path | None = None,
+                 runs: Path | None = None):
     if name == "fast":
         return FastBackend()
     if name == "dem":
-        return DemBackend(out / "dem_runs", command=command, cache=cache)
+        return DemBackend(runs or out / "dem_runs", command=command, cache=cache)
     raise GapInputError(f"--backend {name}: unknown backend (fix: use fast or dem)")

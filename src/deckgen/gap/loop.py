@@ -182,7 +182,7 @@ def functional_forms(measured: Measured, Y, P, n, sigma, responses, alpha: float
     for j, r in enumerate(responses):
         z2 = float(np.sum(n * (Y[:, j] - P[:, j]) ** 2 / sigma[j] ** 2))
         p_resp = float(stats.chi2.sf(z2, len(Y)))
-        if p_resp >= alpha or not facs:
+        if p_resp >= alpha:
             continue
         rel = (np.sign(Y[:, j]) == np.sign(P[:, j])).all() and (np.abs(P[:, j]) > 0.05 * np.abs(Y[:, j]).max()).all()
         q = np.log(Y[:, j] / P[:, j]) if rel else Y[:, j] - P[:, j]
@@ -205,12 +205,22 @@ def functional_forms(measured: Measured, Y, P, n, sigma, responses, alpha: float
                     best = cand
         if best and best["p_value"] < alpha:
             out.append(best)
+        else:  # significant misfit that no factor explains: a constant offset or ratio
+            c0 = float(np.average(q, weights=w))
+            out.append({"response": r, "residual": "ln(measured/model)" if rel else "measured - model [N]",
+                        "factor": None, "form": "constant", "coefficients": [c0], "p_value": p_resp,
+                        "r_squared": 0.0, "aic": math.nan})
     return out
 
 
 def _describe_form(f: dict[str, Any]) -> str:
     c = f["coefficients"]
     x = f["factor"]
+    if f["form"] == "constant":
+        what = (f"measured/model = {math.exp(c[0]):.3g}" if f["residual"].startswith("ln")
+                else f"measured - model = {c[0]:.4g} N")
+        return (f"{f['response']}: {what} in every case, no factor dependence (misfit p {f['p_value']:.2g}): "
+                f"a level error, not a factor effect")
     if f["residual"].startswith("ln"):
         lhs = f"measured/model of {f['response']}"
         forms = {"linear": f"exp({c[0]:.3g} + {c[1]:.3g} {x})", "logarithmic": f"{math.exp(c[0]):.3g} * {x}^{c[1]:.3g}",
@@ -367,6 +377,9 @@ def run_gap(measured: Measured, backend: Any, *, candidates: list[str] | None = 
                                       "value_all_cases": fits[named][0] if c.grid is not None else None,
                                       "range": [mg.lo, mg.hi]})
     forms = functional_forms(measured, Y, A if named else B, n, sigma, responses, alpha_gap) if verdict != "within_noise" else []
+    forms_best = []
+    if verdict == "unexplained" and best is not None:
+        forms_best = functional_forms(measured, Y, fits[best["id"]][2], n, sigma, responses, alpha_gap)
     subsets = {"all": allr, "fit": fit_rows, "held_out": held}
 
     def gaps(P):
@@ -408,6 +421,7 @@ def run_gap(measured: Measured, backend: Any, *, candidates: list[str] | None = 
         "noise": noise,
         "residual_vs_factor": residual_factor_stats(measured, Y, B, n, sigma, responses),
         "residual_forms": [dict(f, description=_describe_form(f)) for f in forms],
+        "residual_forms_after_best_candidate": [dict(f, description=_describe_form(f)) for f in forms_best],
         "per_case": per_case,
         "responses": responses,
         "factors": measured.factors,

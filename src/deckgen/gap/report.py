@@ -134,6 +134,9 @@ def markdown(report: dict[str, Any], measured_path: str, base_path: str) -> str:
     if report["residual_forms"]:
         L += ["", "Functional form of the remaining residuals (best AIC per response):", ""]
         L += [f"- {f['description']}" for f in report["residual_forms"]]
+    if report.get("residual_forms_after_best_candidate"):
+        L += ["", f"What remains once the best candidate ({report['ranking'][0]['id']}) is added:", ""]
+        L += [f"- {f['description']}" for f in report["residual_forms_after_best_candidate"]]
     ep = report["effect_parameters"]
     if ep:
         L += ["", "## Add", "", f"Switch: `{json.dumps(ep['switch'])}`" + (

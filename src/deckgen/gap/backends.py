@@ -23,8 +23,9 @@ class FastBackend:
     name = "fast"
     #: grid points per fitted magnitude (predictions are interpolated between them)
     grid_points = 41
-    #: relative scatter assumed when MEASURED.csv has no replicates: the packing-seed scatter of
-    #: steady mean forces measured on small DEM cuts (docs/discrepancy.md, "Noise")
+    #: relative scatter assumed when MEASURED.csv has no replicates (a lab-test scale: seed 000
+    #: Table 4 and seed 001 Table 3 differ from their models by 2-19 %); an assumption, see
+    #: docs/discrepancy.md for the much larger packing-seed scatter of tiny DEM blocks
     default_cv = 0.05
 
     def simulate(self, cases: pd.DataFrame) -> pd.DataFrame:

@@ -9,6 +9,8 @@
     deckgen aggregate DIR... --out DIR   one tidy table per kind across runs
     deckgen plot DIR --out DIR           PNG plots of one parsed run
     deckgen stl CASE --out FILE          the case's cutter as a binary STL
+    deckgen gap --measured CSV --base CASE --out DIR [--backend fast|dem]
+                                         discrepancy loop: name the missing effect (docs/discrepancy.md)
 
 User mistakes end in one line ``deckgen: error: ...`` and exit code 2, never a traceback.
 """
@@ -176,6 +178,25 @@ def cmd_stl(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_gap(args: argparse.Namespace) -> int:
+    from deckgen.gap import gap
+    from deckgen.spec import SpecError
+
+    cands = [c.strip() for c in args.candidates.split(",") if c.strip()] if args.candidates else None
+    if args.noise_cv is not None and not (0 < args.noise_cv < 1):
+        raise SpecError(f"--noise-cv {args.noise_cv:g}: must lie in (0, 1) (fix: e.g. 0.05 for 5 % scatter)")
+    rep = gap(args.measured, args.base, args.out, backend=args.backend, candidates=cands, noise_cv=args.noise_cv,
+              command=_command(args), cache=_cache(args), runs=Path(args.runs) if args.runs else None)
+    print(f"{args.measured}: {rep['cases']} cases, {rep['rows']} rows, backend {rep['backend']}: "
+          f"named effect {rep['named_effect'] or 'none'} ({rep['verdict']})")
+    print(f"  {rep['reason']}")
+    for r in rep["responses"]:
+        b, a = rep["gap_before"][r], rep["gap_after"][r]
+        print(f"  {r}: RMSE {b['rmse']:.4g} -> {a['rmse']:.4g} N, MAPE {b['mape']:.3g} -> {a['mape']:.3g} %")
+    print(f"wrote {args.out}/report.json, report.md, parity.png, residuals.png")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="deckgen", description="Bonded-particle DEM decks for rock cutting.")
     p.add_argument("--version", action="version", version=f"deckgen {__version__}")
@@ -228,6 +249,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", required=True)
     s.add_argument("--offset-mm", type=float, default=0.0, help="inward offset (e.g. the shell radius)")
     s.set_defaults(func=cmd_stl)
+    s = sub.add_parser("gap", help="discrepancy loop: find, name, add and show the missing effect")
+    s.add_argument("--measured", required=True, help="MEASURED.csv: factor columns = spec field paths, "
+                   "response columns = force table names (N), optional replicate")
+    s.add_argument("--base", required=True, help="base case YAML (the current model)")
+    s.add_argument("--out", required=True, help="output folder (report.json, report.md, PNG plots)")
+    s.add_argument("--backend", default="fast", help="fast (reduced model, seconds) or dem (LAMMPS decks)")
+    s.add_argument("--candidates", help="comma-separated catalogue ids to consider (default: all)")
+    s.add_argument("--noise-cv", type=float, help="relative scatter to assume when there are no replicates")
+    s.add_argument("--runs", help="dem backend: folder of the (cached) runs (default: OUT/dem_runs)")
+    engine_opts(s)
+    s.set_defaults(func=cmd_gap)
     return p
 
 

@@ -83,15 +83,79 @@ def cutter_params(case: Case) -> tuple[str, dict[str, float]]:
     return c.kind, p
 
 
+def cutter_modifications(case: Case) -> dict[str, float]:
+    """Wear flat and axis tilt of the case's cutter (:func:`deckgen.geometry.build_cutter` keywords)."""
+    return {"wear": case.cutter.wear_flat_mm * MM, "tilt_deg": case.cutter.tilt_deg}
+
+
+def neighbour_groove_mask(case: Case, x: np.ndarray) -> np.ndarray:
+    """Grains whose centres lie in the grooves of the same (worn) disc cut at y = +-S beforehand.
+
+    Relieved cutting (seed 001): the neighbouring cuts ran the whole block length at the same
+    penetration, so their groove is the disc's cross-section profile at depth p swept along x.
+    """
+    from matplotlib.path import Path as MplPath
+
+    from deckgen.geometry import _coerce_params, wear_flat
+
+    S = case.kinematics.neighbour_spacing_mm
+    sp = case.specimen
+    if S is None or not isinstance(sp, CuttingBlock):
+        return np.zeros(len(x), bool)
+    kind, prm = cutter_params(case)
+    prof = wear_flat(_coerce_params(kind, prm).profile(), case.cutter.wear_flat_mm * MM)
+    R = float(prof[:, 0].max())
+    zc = sp.height_mm * MM - case.kinematics.penetration_mm * MM + R
+    poly = MplPath(prof)
+    out = np.zeros(len(x), bool)
+    for y0 in (-S * MM, S * MM):
+        pts = np.column_stack([zc - x[:, 2], x[:, 1] - y0])
+        out |= poly.contains_points(pts) & (x[:, 2] > zc - R)
+    return out
+
+
+def confining_faces(case: Case, x: np.ndarray, bounds: Any, fixed: list[dict[str, Any]], slab: float,
+                    pad: float) -> list[dict[str, Any]]:
+    """Side faces (y min, y max, unless held fixed) loaded by ``specimen.confining_stress_MPa``.
+
+    The face load s3 * (length * height) is shared equally by the face's boundary grains (centres
+    within one grain diameter of the face, not held fixed) as a constant inward ``fix addforce``.
+    """
+    sp = case.specimen
+    if not isinstance(sp, CuttingBlock) or sp.confining_stress_MPa <= 0:
+        return []
+    bb = np.asarray(bounds, dtype=float).reshape(3, 2)
+    held = np.zeros(len(x), bool)
+    for f in fixed:
+        lo, hi = np.asarray(f["bounds"]).reshape(3, 2).T
+        held |= ((x >= lo) & (x <= hi)).all(axis=1)
+    out = []
+    area = sp.length_mm * MM * sp.height_mm * MM
+    for name, sign in (("ymin", 1.0), ("ymax", -1.0)):
+        if name in sp.fixed_faces:
+            continue
+        box = bb.copy()
+        box[0] = (bb[0, 0] - pad, bb[0, 1] + pad)
+        box[2] = (bb[2, 0] - pad, bb[2, 1] + pad)
+        box[1] = (bb[1, 0] - pad, bb[1, 0] + slab) if name == "ymin" else (bb[1, 1] - slab, bb[1, 1] + pad)
+        inside = ((x >= box[:, 0]) & (x <= box[:, 1])).all(axis=1) & ~held
+        n = int(inside.sum())
+        if n:
+            out.append({"name": name, "bounds": [float(v) for v in box.ravel()], "n": n,
+                        "force": sign * sp.confining_stress_MPa * MPA * area / n})
+    return out
+
+
 def build_cutter_files(case: Case, out: Path) -> dict[str, Any]:
     """Write cutter.stl (true surface) and cutter_shell.stl (inward offset by the shell radius)."""
     from deckgen.geometry import build_cutter, cutter_summary, write_stl
 
     kind, p = cutter_params(case)
     rs = case.cutter.shell_radius_mm * MM
+    mods = cutter_modifications(case)
     try:
-        true = build_cutter(kind, p)
-        shell = build_cutter(kind, p, offset=rs)
+        true = build_cutter(kind, p, **mods)
+        shell = build_cutter(kind, p, offset=rs, **mods)
     except ValueError as exc:
         raise SpecError(f"cutter: {exc}") from None
     write_stl(true, out / "cutter.stl")
@@ -228,6 +292,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     pack_folder = ensure_packing(case, cache, progress=progress, command=command)
     atoms, packinfo = load_packing(pack_folder)
     b, c, run = case.bonds, case.contact, case.run
+    grooves = neighbour_groove_mask(case, atoms.x)
+    if grooves.any():  # relieved cutting: the neighbours' grooves are not in the block
+        keep = ~grooves
+        atoms = type(atoms)(ids=np.arange(1, int(keep.sum()) + 1), types=atoms.types[keep], radius=atoms.radius[keep],
+                            density=atoms.density[keep], x=atoms.x[keep], box=atoms.box)
 
     # ---- bonded specimen
     r_full = atoms.radius
@@ -415,7 +484,12 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("nsteps", steps, "steps of the cut", "steps"),
             _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
         ]
-        ctx["fixed_faces"] = fixed_face_boxes(sp, reg, 2.0 * float(r_full.max()), pad)
+        fixed_slab = 2.0 * float(r_full.max())
+        faces = fixed_face_boxes(sp, reg, fixed_slab, pad)
+        ctx["fixed_faces"] = faces
+        ctx["confine"] = confining_faces(case, atoms.x, reg.bounds, faces, fixed_slab, pad)
+        if grooves.any():
+            derived["neighbour_groove_grains_removed"] = int(grooves.sum())
         ctx["rotary"] = case.kinematics.mode == "rotary"
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),

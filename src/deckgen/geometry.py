@@ -65,10 +65,12 @@ __all__ = [
     "cone_disc",
     "cutter_summary",
     "offset_profile",
+    "profile_width",
     "revolve",
     "segments_for_radius",
     "tilt",
     "v_disc",
+    "wear_flat",
     "write_stl",
 ]
 
@@ -578,6 +580,68 @@ CUTTER_KINDS = tuple(_PARAMS)
 
 
 # ---------------------------------------------------------------------------
+# slices and wear
+# ---------------------------------------------------------------------------
+
+
+def profile_width(profile: Any, rho: Any) -> np.ndarray:
+    """Axial width [m] of a convex profile's slice at radius ``rho`` [m] (array-like; 0 outside).
+
+    The slice of a convex polygon by the line ``rho = const`` is one segment; its length is the
+    disc's width at that radius (e.g. the tip land width at the rim, the groove width at a depth).
+    """
+    return _slice_width(_ccw(_clean(profile)), rho)
+
+
+def _slice_width(p: np.ndarray, rho: Any) -> np.ndarray:
+    """:func:`profile_width` of an already cleaned profile."""
+    q = np.roll(p, -1, axis=0)
+    r = np.atleast_1d(np.asarray(rho, dtype=float))
+    r0, r1, a0, a1 = p[:, 0][None, :], q[:, 0][None, :], p[:, 1][None, :], q[:, 1][None, :]
+    lo, hi = np.minimum(r0, r1), np.maximum(r0, r1)
+    hit = (r[:, None] >= lo) & (r[:, None] <= hi) & (hi > lo)
+    t = np.where(hit, (r[:, None] - r0) / np.where(r1 != r0, r1 - r0, 1.0), 0.0)
+    a = a0 + t * (a1 - a0)
+    amax = np.where(hit, a, -np.inf).max(axis=1)
+    amin = np.where(hit, a, np.inf).min(axis=1)
+    return np.where(np.isfinite(amax) & np.isfinite(amin), np.maximum(amax - amin, 0.0), 0.0)
+
+
+def wear_flat(profile: Any, width: float) -> np.ndarray:
+    """The profile worn down to a flat land of axial ``width`` [m] at the rim.
+
+    The rim is cut off by the cylinder ``rho = rho_w`` where the (convex) profile is ``width``
+    wide, as abrasive wear flattens a disc's edge (seed 003 sec. 1: "a wear flat ... the tool will
+    attack the rock with a flat area"). Returns the profile unchanged for ``width = 0`` and the
+    profile's own tip land when it is already at least that wide.
+    """
+    from scipy.optimize import brentq
+
+    w = _non_negative("width", width)
+    p = _ccw(_clean(profile))
+    if w == 0.0:
+        return p
+    R = float(p[:, 0].max())
+    if float(_slice_width(p, R * (1.0 - 1e-12))[0]) >= w:
+        return p
+    hub = float(p[:, 1].max() - p[:, 1].min())
+    if w >= hub:
+        raise ValueError(f"wear flat width={w!r} m is not less than the disc width {hub:.6g} m; use a narrower flat")
+    lo = float(p[p[:, 0] > 0, 0].min()) if (p[:, 0] > 0).any() else 0.0
+    rho_w = brentq(lambda x: float(_slice_width(p, x)[0]) - w, lo, R * (1.0 - 1e-12), xtol=1e-12)
+    out: list[tuple[float, float]] = []
+    for i in range(len(p)):  # clip to rho <= rho_w (Sutherland-Hodgman, one half-plane)
+        a, b = p[i], p[(i + 1) % len(p)]
+        ina, inb = a[0] <= rho_w, b[0] <= rho_w
+        if ina:
+            out.append((float(a[0]), float(a[1])))
+        if ina != inb:
+            t = (rho_w - a[0]) / (b[0] - a[0])
+            out.append((rho_w, float(a[1] + t * (b[1] - a[1]))))
+    return _ccw(_clean(np.array(out)))
+
+
+# ---------------------------------------------------------------------------
 # offset
 # ---------------------------------------------------------------------------
 
@@ -837,6 +901,8 @@ def build_cutter(
     n_segments: int | None = None,
     axis: str = "y",
     offset: float = 0.0,
+    wear: float = 0.0,
+    tilt_deg: float = 0.0,
 ) -> trimesh.Trimesh:
     """Build the cutter mesh [m] for ``kind`` in :data:`CUTTER_KINDS`.
 
@@ -855,12 +921,20 @@ def build_cutter(
         Inward surface offset [m] (e.g. the LAMMPS shell-sphere radius r_s),
         see :func:`offset_profile`. Default 0.
 
+    wear : float
+        Width [m] of a worn flat land at the rim, see :func:`wear_flat` (applied before the offset).
+    tilt_deg : float
+        Tilt [deg] of the disc axis about the global x axis, rim toward +y for positive values
+        (after any clearance tilt; requires ``axis="y"``).
+
     For "cone_disc" a non-zero ``clearance_angle_deg`` tilts the revolved
     cutter, see :class:`ConeDiscParams` (requires ``axis="y"``).
     """
     prm = _coerce_params(kind, params)
     _check_axis(axis)
     prof = prm.profile()
+    if wear:
+        prof = wear_flat(prof, wear)
     if offset:
         prof = offset_profile(prof, offset)
     mesh = revolve(prof, n_segments=n_segments, axis=axis)
@@ -875,6 +949,10 @@ def build_cutter(
                     f"use axis='y' and rotate the mesh afterwards"
                 )
             mesh = tilt(mesh, -c, about="x")
+    if tilt_deg:
+        if axis != "y":
+            raise ValueError(f"tilt_deg={tilt_deg!r} is only defined for axis='y' (got axis={axis!r})")
+        mesh = tilt(mesh, _finite("tilt_deg", tilt_deg), about="x")
     mesh.metadata["deckgen_kind"] = kind
     return mesh
 

@@ -179,6 +179,10 @@ class CuttingBlock(_Model):
         "Faces whose boundary grains are held fixed (grains within one max diameter of the face). "
         "The block spans x in [0, length], y in [-width/2, width/2], z in [0, height]; the top (z max) is cut.",
     )
+    confining_stress_MPa: float = _f(
+        0.0, "MPa", "Constant confining pressure on the free side faces (y min, y max) of the block, as an "
+        "inward force on their boundary grains (0 = unconfined; discrepancy effect 'confinement').", ge=0, le=200,
+    )
 
 
 Specimen = Annotated[Union[UcsCylinder, BrazilianDisc, CuttingBlock], Field(discriminator="kind")]
@@ -205,6 +209,14 @@ class Cutter(_Model):
         0.3, "mm", "LAMMPS: radius of the spheres that represent the cutter surface.", gt=0
     )
     shell_spacing: float = _f(1.0, "1", "LAMMPS: centre spacing of shell spheres, in shell diameters.", gt=0.3, le=1.5)
+    wear_flat_mm: float = _f(
+        0.0, "mm", "Width of a worn, flat land at the rim: the profile is cut off at the radius where it is this wide "
+        "(0 = sharp, as built; discrepancy effect 'wear_flat').", ge=0,
+    )
+    tilt_deg: float = _f(
+        0.0, "deg", "Tilt of the disc axis about the cut direction (x): the rim leans toward +y for positive values "
+        "(0 = upright; discrepancy effect 'tilt').", ge=-30, le=30,
+    )
 
 
 class Kinematics(_Model):
@@ -231,6 +243,10 @@ class Kinematics(_Model):
     frequency_hz: float = _f(0.0, "Hz", "oscillation: frequency f (rev/s).", ge=0)
     spin: Literal["none", "rolling", "shaft"] = _f(
         "none", "token", "Spin of the disc about its own axis: none, rolling (v/R) or shaft (with the eccentric shaft)."
+    )
+    neighbour_spacing_mm: float | None = _f(
+        None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "
+        "cut (relieved cutting between neighbours, seed 001); none = an isolated (unrelieved) groove.", gt=0,
     )
 
 
@@ -348,14 +364,20 @@ def _fix_hint(err: dict[str, Any]) -> str:
     return "see the schema for allowed values"
 
 
+def field_and_message(err: dict[str, Any]) -> tuple[str, str, bool]:
+    """(field path, message, raised by a cross-field check) of one pydantic error."""
+    field = _loc(err["loc"])
+    msg = err["msg"].removeprefix("Value error, ")
+    m = re.match(r"^([a-z_][a-z0-9_.]*): (.*)$", msg)
+    if m and field == "(top level)":
+        return m.group(1), m.group(2), True
+    return field, msg, False
+
+
 def format_validation_error(path: str | Path, exc: ValidationError) -> str:
     lines = []
     for err in exc.errors():
-        field = _loc(err["loc"])
-        msg = err["msg"].removeprefix("Value error, ")
-        m = re.match(r"^([a-z_][a-z0-9_.]*): (.*)$", msg)
-        if m and field == "(top level)":
-            field, msg = m.group(1), m.group(2)
+        field, msg, _ = field_and_message(err)
         lines.append(f"{path}: {field}: {msg} (fix: {_fix_hint(err)})")
     return "\n".join(lines)
 

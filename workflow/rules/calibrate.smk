@@ -7,19 +7,6 @@
 wildcard_constraints:
     rock="[a-z][a-z0-9_]*",
 
-#: the rocks of issue #3 (cases/materials/<rock>.yaml)
-CAL_ROCKS = ["savonniere_limestone", "concrete", "sandstone", "colorado_red_granite"]
-CAL_STUDIES = f"{RESULTS}/calibration/studies"
-
-
-def calib_engine_args():
-    """UCS and BTS of a point side by side on half the ranks each (1-rank runs share 2 cores best)."""
-    if config.get("engine_cmd"):
-        return engine_args()
-    ranks = int(config.get("ranks", 2))
-    return f"--jobs 2 --ranks {max(1, ranks // 2)}" if ranks >= 2 else "--ranks 1"
-
-
 rule calibrate:
     input:
         targets="cases/materials/{rock}.yaml",
@@ -51,8 +38,10 @@ rule calibration_seeds:
     log:
         f"{RESULTS}/logs/calibration_seeds/{{rock}}.log",
     threads: config.get("ranks", 2)
+    conda:
+        "../envs/deckgen.yaml"
     params:
-        out=CAL_STUDIES,
+        out=lambda w, output: str(Path(output[0]).parent),
         cache=f"{RESULTS}/.cache",
         engine=calib_engine_args(),
     shell:
@@ -70,8 +59,10 @@ rule calibration_quasistatic:
         f"{RESULTS}/logs/calibration_quasistatic/{{rock}}.log",
     threads: config.get("ranks", 2)
     priority: 5
+    conda:
+        "../envs/deckgen.yaml"
     params:
-        out=CAL_STUDIES,
+        out=lambda w, output: str(Path(output[0]).parent),
         cache=f"{RESULTS}/.cache",
         engine=calib_engine_args(),
     shell:
@@ -87,10 +78,14 @@ rule calibration_table:
         qs=expand(f"{CAL_STUDIES}/quasistatic_{{rock}}.csv", rock=CAL_ROCKS),
     output:
         f"{RESULTS}/calibration/table.md",
+    log:
+        f"{RESULTS}/logs/calibration_table.log",
+    conda:
+        "../envs/deckgen.yaml"
     params:
-        out=CAL_STUDIES,
+        out=lambda w, input: str(Path(input.seeds[0]).parent),
     shell:
-        "python -m deckgen.calibration_studies table {input.cards} --out {params.out} --write {output}"
+        "python -m deckgen.calibration_studies table {input.cards} --out {params.out} --write {output} > {log} 2>&1"
 
 
 rule calibration_report:

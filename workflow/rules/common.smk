@@ -36,3 +36,16 @@ def tables():
 
 def plots():
     return expand(f"{RESULTS}/{{case}}/plots/done.txt", case=list(CASE_FILES))
+
+
+#: the rocks of issue #3 (cases/materials/<rock>.yaml)
+CAL_ROCKS = ["savonniere_limestone", "concrete", "sandstone", "colorado_red_granite"]
+CAL_STUDIES = f"{RESULTS}/calibration/studies"
+
+
+def calib_engine_args():
+    """UCS and BTS of a point side by side on half the ranks each (1-rank runs share 2 cores best)."""
+    if config.get("engine_cmd"):
+        return engine_args()
+    ranks = int(config.get("ranks", 2))
+    return f"--jobs 2 --ranks {max(1, ranks // 2)}" if ranks >= 2 else "--ranks 1"

@@ -217,7 +217,7 @@ def pack_context(case: Case) -> dict[str, Any]:
         ("nu_c", nu, "grain Poisson's ratio", "1"),
         # damping tsuji reads this as a restitution (LAMMPS turns it into alpha ~ 0.1 for 1.2728, which was
         # meant as the alpha of e = 0); the drag settles the packing; kept so cached packings stay valid
-        ("damp_alpha", 1.2728, "Tsuji input (a restitution; see packing.py)", "1"),
+        ("damp_alpha", 1.2728, "Tsuji input, read as a restitution (see packing.py)", "1"),
         ("drag_time", p.drag_time_s, "viscous drag relaxation time", "s"),
         ("seed", 1 + p.seed % 900_000_000, "random seed of the drag fix", "1"),
         ("dt", dt, "time step (0.2 x Rayleigh time of the smallest grain at insertion size)", "s"),

@@ -13,6 +13,7 @@ include: "workflow/rules/parse.smk"
 include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/plot.smk"
 include: "workflow/rules/calibrate.smk"
+include: "workflow/rules/families.smk"
 
 
 rule all:

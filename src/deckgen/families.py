@@ -4,6 +4,8 @@
                                                     index.csv and README.md of every family
     python -m deckgen.families check [--root DIR]   exit 1 if a committed file differs from the generator
     python -m deckgen.families list                 one line per case: family, scale, name, estimates
+    python -m deckgen.families report --family F --index cases/F/index.csv --out DIR PARSED...
+                                                    family table (factors, grains, wall time, forces) + plots
 
 Each family has a **full-scale** set (the seed's geometry and speeds, for clusters) and a
 **reduced-scale** set that runs on 2 cores in minutes per case. Every case file starts with a header
@@ -545,6 +547,95 @@ def family_files(root: Path) -> dict[Path, str]:
     return files
 
 
+# =========================================================================== per-family report
+#: per family: (x factor, series grouping factors, y quantities) of the force-vs-factor plot
+PLOTS: dict[str, tuple[str, list[str], list[str]]] = {
+    "indentation_asymmetric": ("cut_spacing_mm", ["rock", "disc_diameter_mm"],
+                               ["force_normal_N_peak", "lateral_to_normal_ratio_1"]),
+    "linear_ccs": ("penetration_mm", [], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
+                                           "rolling_to_normal_ratio_1"]),
+    "rotary": ("rotary_radius_mm", [], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
+                                        "force_side_N_mean_steady"]),
+    "odc": ("frequency_hz", ["eccentricity_ratio_1", "speed_m_s"], ["force_magnitude_N_mean_steady",
+                                                                   "contact_fraction_steady_1"]),
+}
+#: summary fields copied into the family table (beside the factors of index.csv)
+TABLE_FIELDS = [
+    "n_grains", "n_bonds_initial", "steps", "dt_s", "wall_s", "particle_steps_per_s", "run_completed",
+    "force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
+    "force_magnitude_N_mean_steady", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
+    "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
+    "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
+    "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
+    "specific_energy_kinematic_J_m3",
+]
+
+
+def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
+    """One row per run of a family: its factors (index.csv), grains, wall time and force/damage metrics."""
+    import json
+
+    import pandas as pd
+
+    idx = pd.read_csv(index_csv, keep_default_na=False)
+    rows = []
+    for d in map(Path, parsed_dirs):
+        s = json.loads((d / "summary.json").read_text())
+        row = {k: s.get(k, float("nan")) for k in TABLE_FIELDS}
+        fn, fs = row["force_normal_N_peak"], row["force_side_N_peak"]
+        try:
+            row["lateral_to_normal_ratio_1"] = abs(float(fs)) / abs(float(fn))
+        except (TypeError, ValueError, ZeroDivisionError):
+            row["lateral_to_normal_ratio_1"] = float("nan")
+        rows.append({"case": s["case"], **row})
+    runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "lateral_to_normal_ratio_1"])
+    return idx.merge(runs, on="case", how="inner")
+
+
+def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
+    """Force (and ratio) vs the family's main factor, one line per group; PNGs into ``out``."""
+    import pandas as pd
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    x, groups, ys = PLOTS[family]
+    files = []
+    for y in ys:
+        fig = Figure(figsize=(6.5, 4.2), dpi=120, layout="constrained")
+        FigureCanvasAgg(fig)
+        ax = fig.add_subplot(1, 1, 1)
+        t = table.copy()
+        t[x] = pd.to_numeric(t[x], errors="coerce")
+        t[y] = pd.to_numeric(t[y], errors="coerce")
+        for key, g in (t.groupby(groups) if groups else [((), t)]):
+            g = g.sort_values(x)
+            label = ", ".join(f"{k} {v}" for k, v in zip(groups, key if isinstance(key, tuple) else (key,))) or family
+            ax.plot(g[x], g[y], "o-", label=label)
+        if x == "rotary_radius_mm":
+            ax.set_xscale("log")
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.set_title(f"{family}: {y} vs {x}", fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        path = out / f"{family}_{y}_vs_{x}.png"
+        fig.savefig(path)
+        files.append(path)
+    return files
+
+
+def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], out: str | Path) -> Path:
+    table = family_table(index_csv, parsed_dirs)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "family_table.csv"
+    table.to_csv(path, index=False)
+    family_plots(family, table, out / "plots")
+    return path
+
+
 def _root(arg: str | None) -> Path:
     if arg:
         return Path(arg)
@@ -555,9 +646,19 @@ def _root(arg: str | None) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m deckgen.families", description=__doc__.split("\n\n")[0])
-    p.add_argument("command", choices=["write", "check", "list"])
+    p.add_argument("command", choices=["write", "check", "list", "report"])
     p.add_argument("--root", help="repository root (default: the one deckgen runs from)")
+    p.add_argument("--family", choices=list(FAMILIES), help="report: the family")
+    p.add_argument("--index", help="report: the family's index.csv")
+    p.add_argument("--out", help="report: output folder (family_table.csv, plots/)")
+    p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json)")
     args = p.parse_args(argv)
+    if args.command == "report":
+        if not (args.family and args.index and args.out):
+            p.error("report needs --family, --index and --out")
+        path = report(args.family, args.index, args.parsed, args.out)
+        print(f"wrote {path} ({len(args.parsed)} runs) and plots")
+        return 0
     root = _root(args.root)
     if args.command == "list":
         for c in all_cases():

@@ -108,6 +108,13 @@ def middle_window(length_mm: float, radius_mm: float, penetration_mm: float, cle
     return [_r(a, 2), _r(b, 2)]
 
 
+def middle_travel(length_mm: float, radius_mm: float, penetration_mm: float, clearance_mm: float, hi: float = 0.6) -> float:
+    """Travel that ends when the contact-patch centre reaches ``hi`` of the block length (rounded up to 0.5 mm),
+    so the run stops at the end of the middle window and the disc front stays clear of the fixed far end."""
+    t = hi * length_mm + half_chord_mm(radius_mm, penetration_mm) / 2 + clearance_mm
+    return _r(math.ceil(2 * t) / 2, 1)
+
+
 @dataclass
 class CaseDef:
     family: str
@@ -267,7 +274,7 @@ def linear_ccs() -> list[CaseDef]:
                 p = p_full
                 L, W, H = 304, 120, 60
                 clear = 1.0
-                travel = math.floor(L - 2 * half_chord_mm(R, max(SEED001_PENETRATIONS)) - clear - 1)
+                travel = middle_travel(L, R, p, clear)
                 name = f"lin_full_p{_tag(p)}"
                 packing = {"radius_min_mm": 0.5, "radius_max_mm": 0.75}
                 bonds = placeholder_bonds(rock, 40)
@@ -283,16 +290,16 @@ def linear_ccs() -> list[CaseDef]:
                     "section (assumed; Fig. 9 not transcribed); bottom and far end fixed. Single disc: the three-disc",
                     "spacing S = 25/51/76/100 mm needs kinematics.neighbour_spacing_mm (TODO, cases/linear_ccs/README.md).",
                     "Steady window: contact patch in the middle 40-60 % of the rock (seed 001: 400-600 ms), clipped to",
-                    "the travel. Grains r 0.5-0.75 mm: p = 1.9 mm is only 1.5 grain diameters (seed 001 used 0.3 mm SPG",
+                    "the travel, which ends there. Grains r 0.5-0.75 mm: p = 1.9 mm is only 1.5 grain diameters (seed 001 used 0.3 mm SPG",
                     "particles; a DEM at that size is ~30x more grains). Bonds: placeholder (E_b 40 GPa, strengths",
                     "scaled from the smoke UCS to 158 MPa); use results/calibration/colorado_red_granite/card.yaml.",
                 ]
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
                 p = _r(p_full * fp, 3)
-                L, W, H = 40, 20, 12
+                L, W, H = 26, 20, 12
                 clear = 0.3
-                travel = 10
+                travel = middle_travel(L, R, p, clear)
                 name = f"lin_red_p{_tag(p_full)}"
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds = placeholder_bonds(rock, 10)
@@ -305,7 +312,7 @@ def linear_ccs() -> list[CaseDef]:
                     f"Disc geometry factor 1/8: CCS D {_r(CCS_D_MM * f)} mm (17 in), tip width {_r(CCS_TIP_WIDTH_MM * f)} mm (12.5),",
                     f"hub {_r(CCS_HUB_MM * f)} mm; tip radius 0.3 mm (= shell radius). Penetration factor 1/2, not 1/8: p = {p} mm,",
                     "because grains are not scaled (r 0.7-1.0 mm; 1/8 would put p below one grain), so p/R is 4x the",
-                    "seed's (contact angle ~2x). Block 40 x 20 x 12 mm (not 304 mm long: sized for a 10 mm cut), steady",
+                    f"seed's (contact angle ~2x). Block 26 x 20 x 12 mm (not 304/8 = 38 mm long), {travel} mm of travel; steady",
                     "window as full scale (contact patch in the middle 40-60 % of the block). 2 m/s (6x the seed's 0.33)",
                     "with rolling spin, for ~1e5 steps. Bonds softened to E_b 10 GPa (dt x2; placeholder strengths",
                     "scaled from the smoke UCS to CRG's 158 MPa) until results/calibration/colorado_red_granite/card.yaml",
@@ -335,8 +342,9 @@ def rotary() -> list[CaseDef]:
             if scale == "full":
                 f, fp, R = 1.0, 1.0, CCS_D_MM / 2
                 p, r = 6.4, r_full
-                L, W, H = 240, 170, 60
-                clear, travel = 1.0, 120
+                L, W, H = 240, 220, 60
+                clear = 1.0
+                travel = middle_travel(L, R, p, clear)
                 name = f"rot_full_r{r_full}"
                 packing = {"radius_min_mm": 0.5, "radius_max_mm": 0.75}
                 bonds = placeholder_bonds(rock, 40)
@@ -348,15 +356,17 @@ def rotary() -> list[CaseDef]:
                     "(Table 2: 250/500/1000, and 3000 for run 12). 17-inch CCS disc as linear_ccs (tip width 12.5 mm,",
                     "seed 002 sec. 3), p = 6.4 mm, UCS 158 MPa rock (Colorado red granite). The centre runs on a circle of",
                     "radius r and the disc yaws with it; forces in the disc frame (n, r, s) of seed 002 Fig. 4. Speed",
-                    "0.33 m/s with rolling spin as seed 001 (seed 002 gives none). Block 240 x 170 x 60 mm (seed 002",
-                    "Fig. 2 not transcribed): wide enough for the 120 mm arc at r = 250 mm. Grains r 0.5-0.75 mm;",
+                    "0.33 m/s with rolling spin as seed 001 (seed 002 gives none). Block 240 x 220 x 60 mm (seed 002",
+                    f"Fig. 2 not transcribed): wide enough for the {travel} mm arc at r = 250 mm; travel and steady window",
+                    "as linear_ccs (contact patch in the middle 40-60 % of the block length). Grains r 0.5-0.75 mm;",
                     "placeholder bonds (as linear_ccs full). Single disc: spacing S is a TODO (linear_ccs README).",
                 ]
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
                 p, r = _r(6.4 * REDUCED_PEN, 3), _r(r_full * REDUCED_DISC)
-                L, W, H = 40, 30, 12
-                clear, travel = 0.3, 10
+                L, W, H = 26, 42, 10
+                clear = 0.3
+                travel = middle_travel(L, R, p, clear)
                 name = f"rot_red_r{r_full}"
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds = placeholder_bonds(rock, 10)
@@ -367,8 +377,8 @@ def rotary() -> list[CaseDef]:
                     f"Seed 002 (Farrokh), rotary cutting, REDUCED SCALE (2 cores): full-scale r = {r_full} mm.",
                     f"Geometry factor 1/8 on the disc and the path radius: D {_r(CCS_D_MM * f)} mm, tip width",
                     f"{_r(CCS_TIP_WIDTH_MM * f)} mm, r = {r} mm, so the path curvature relative to the disc (R/r) is the seed's.",
-                    f"Penetration factor 1/2 (grains r 0.7-1.0 mm are not scaled): p = {p} mm (6.4). Block 40 x 30 x 12 mm,",
-                    "10 mm of travel (an arc of 0.3 rad at the smallest radius). 2 m/s (6x seed 001's 0.33 m/s) with",
+                    f"Penetration factor 1/2 (grains r 0.7-1.0 mm are not scaled): p = {p} mm (6.4). Block 26 x 42 x 10 mm",
+                    f"(wide for the arc drift), {travel} mm of travel, window as linear_ccs. 2 m/s (6x seed 001's 0.33 m/s) with",
                     "rolling spin; bonds softened to E_b 10 GPa (dt x2), placeholder strengths scaled to UCS 158 MPa.",
                     "Side force and Fr/Fn vs r are the trends to compare; forces scale ~ length^2 (docs/families.md).",
                 ]
@@ -511,7 +521,7 @@ def readme_text(family: str, cases: list[CaseDef]) -> str:
         f"- `full/`: {n['full']} cases at the seed's geometry and speeds (for clusters; they validate, rendering packs the",
         "  full block).",
         f"- `reduced/`: {n['reduced']} cases for 2 cores; the scaling is in each file's header and in `docs/families.md`.",
-        f"- `index.csv`: the factors of every case and rough estimates (grains, time steps); reduced set in total",
+        "- `index.csv`: the factors of every case and rough estimates (grains, time steps); reduced set in total",
         f"  ~{ps:.2g} particle-steps, i.e. ~{ps / 2.0e6 / 60:.0f} min at 2 M particle-steps/s (2 ranks).",
         "",
         f"Run the reduced set: `snakemake --cores 2 family_{family}_reduced` (results in `results/families/{family}_reduced/`).",

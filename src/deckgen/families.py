@@ -64,7 +64,8 @@ ROCKS: dict[str, dict[str, float]] = {
 SOLID_FRACTION_EST = 0.61
 #: Empirical time step of deckgen decks: dt = DT_REF * (r_min / 0.7 mm) * sqrt(10 GPa / E_b) * sqrt(rho / 2650),
 #: from the smoke cut (r 0.7-1.0 mm, E_b 10 GPa, rho 2650: dt 3.93e-8 s; the smoke UCS at 0.6 mm, 40 GPa gives
-#: 1.72e-8 s, the formula 1.68e-8 s). The rotational bond mode of the smallest grain sets dt (docs/model.md).
+#: 1.72e-8 s, the formula 1.68e-8 s), divided by the bond radius multiplier. The rotational bond mode of the
+#: smallest grain sets dt (docs/model.md).
 DT_REF_S = 3.93e-8
 
 
@@ -136,7 +137,9 @@ def estimate(data: dict[str, Any]) -> dict[str, Any]:
     mean_r3 = (b**4 - a**4) / (4 * (b - a)) if b > a else a**3
     vol = sp["length_mm"] * sp["width_mm"] * sp["height_mm"]
     n = SOLID_FRACTION_EST * vol / (4 / 3 * math.pi * mean_r3)
-    dt = DT_REF_S * (a / 0.7) * math.sqrt(10.0 / bd["youngs_modulus_GPa"]) * math.sqrt(rho / 2650.0)
+    # bond stiffness ~ E_b * (lambda r)^2: dt ~ 1/lambda (the radius multiplier; seed 000 uses 1.2)
+    dt = (DT_REF_S * (a / 0.7) * math.sqrt(10.0 / bd["youngs_modulus_GPa"]) * math.sqrt(rho / 2650.0)
+          / bd.get("radius_multiplier", 1.0))
     if kin["mode"] == "indentation":
         dist = kin["penetration_mm"] + kin["start_clearance_mm"]
     else:

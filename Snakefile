@@ -14,6 +14,7 @@ include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/plot.smk"
 include: "workflow/rules/calibrate.smk"
 include: "workflow/rules/gap.smk"
+include: "workflow/rules/families.smk"
 
 
 rule all:

@@ -415,8 +415,8 @@ def test_aggregate_rejects_a_case_twice(parsed, tmp_path):
 
 
 # ----------------------------------------------------------------------------- plots
-@pytest.mark.parametrize("name,kinds", [("ref_ucs", ["stress_strain", "broken_bonds"]),
-                                        ("ref_cut", ["forces_time", "forces_x", "broken_bonds"])])
+@pytest.mark.parametrize("name,kinds", [("ref_ucs", ["stress_strain", "broken_bonds", "damage"]),
+                                        ("ref_cut", ["forces_time", "forces_x", "broken_bonds", "damage"])])
 def test_plot_run_writes_pngs(parsed, tmp_path, name, kinds):
     files = plot_run(parsed[name][1], tmp_path / "plots")
     assert [f.name for f in files] == [f"{name}_{k}.png" for k in kinds]

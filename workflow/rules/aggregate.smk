@@ -3,7 +3,7 @@
 
 rule aggregate:
     input:
-        expand(f"{RESULTS}/{{case}}/parsed/summary.json", case=list(CASE_FILES)),
+        expand(f"{RESULTS}/{{case}}/parsed/summary.json", case=list(DEFAULT_CASES)),
     output:
         tables(),
     conda:
@@ -11,7 +11,7 @@ rule aggregate:
     log:
         f"{RESULTS}/logs/aggregate.log",
     params:
-        dirs=expand(f"{RESULTS}/{{case}}/parsed", case=list(CASE_FILES)),
+        dirs=expand(f"{RESULTS}/{{case}}/parsed", case=list(DEFAULT_CASES)),
         out=lambda w, output: str(Path(output[0]).parent),
     shell:
         "deckgen aggregate {params.dirs} --out {params.out} > {log} 2>&1"

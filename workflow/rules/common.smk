@@ -2,7 +2,23 @@
 from pathlib import Path
 
 RESULTS = config.get("results", "results")
-CASE_FILES = {Path(p).stem: p for p in config["cases"]}
+#: the cases of the default target (workflow/config.yaml)
+DEFAULT_CASES = {Path(p).stem: p for p in config["cases"]}
+#: case families (cases/<family>/{full,reduced}/*.yaml, written by python -m deckgen.families write);
+#: their runs go through the same per-case rules, targets family_<family>_<scale> (rules/families.smk)
+FAMILIES = config.get("families", ["indentation_asymmetric", "linear_ccs", "rotary", "odc"])
+FAMILY_SCALES = ["full", "reduced"]
+FAMILY_CASES = {
+    (fam, scale): {p.stem: str(p) for p in sorted(Path("cases", fam, scale).glob("*.yaml"))}
+    for fam in FAMILIES
+    for scale in FAMILY_SCALES
+}
+CASE_FILES = dict(DEFAULT_CASES)
+for _cases in FAMILY_CASES.values():
+    for _name, _path in _cases.items():
+        if _name in CASE_FILES and CASE_FILES[_name] != _path:
+            raise ValueError(f"case name {_name} is used by {CASE_FILES[_name]} and {_path}: rename one")
+        CASE_FILES[_name] = _path
 TABLE_KINDS = [
     "forces_timeseries",
     "forces_summary",
@@ -35,7 +51,7 @@ def tables():
 
 
 def plots():
-    return expand(f"{RESULTS}/{{case}}/plots/done.txt", case=list(CASE_FILES))
+    return expand(f"{RESULTS}/{{case}}/plots/done.txt", case=list(DEFAULT_CASES))
 
 
 #: the rocks of issue #3 (cases/materials/<rock>.yaml)
@@ -49,3 +65,8 @@ def calib_engine_args():
         return engine_args()
     ranks = int(config.get("ranks", 2))
     return f"--jobs 2 --ranks {max(1, ranks // 2)}" if ranks >= 2 else "--ranks 1"
+
+
+def family_case_names(wildcards):
+    """Case names of one family and scale (rules/families.smk)."""
+    return list(FAMILY_CASES[(wildcards.family, wildcards.scale)])

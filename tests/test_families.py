@@ -1,0 +1,210 @@
+"""Case families of issue #4 (deckgen.families): the committed grids are the generator's, they validate,
+full scale keeps the seeds' numbers, reduced scale says how it is scaled, the workflow plans them."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from deckgen import families as fam
+from deckgen.deck import cutter_path
+from deckgen.spec import MM, load_case
+
+ROOT = Path(__file__).resolve().parents[1]
+SNAKEMAKE = Path(sys.executable).parent / "snakemake"
+NAMES = list(fam.FAMILIES)
+
+
+def _files(family: str, scale: str) -> list[Path]:
+    return sorted((ROOT / "cases" / family / scale).glob("*.yaml"))
+
+
+def _cases(family: str, scale: str):
+    return [load_case(p) for p in _files(family, scale)]
+
+
+def _header(path: Path) -> str:
+    return "\n".join(line for line in path.read_text().splitlines() if line.startswith("#"))
+
+
+def test_generator_reproduces_committed_files_byte_for_byte():
+    files = fam.family_files(ROOT)
+    assert len(files) == 59 + 2 * len(NAMES)  # 59 case files + index.csv and README.md per family
+    for path, text in files.items():
+        assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
+        assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
+    on_disk = {p for f in NAMES for p in (ROOT / "cases" / f).glob("*/*.yaml")}
+    assert on_disk == {p for p in files if p.suffix == ".yaml"}, "stale family case files"
+
+
+def test_case_counts_per_family():
+    counts = {(f, s): len(_files(f, s)) for f in NAMES for s in fam.SCALES}
+    assert counts == {
+        ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
+        ("linear_ccs", "full"): 4, ("linear_ccs", "reduced"): 4,
+        ("rotary", "full"): 4, ("rotary", "reduced"): 4,
+        ("odc", "full"): 10, ("odc", "reduced"): 9,
+    }
+
+
+@pytest.mark.parametrize("family", NAMES)
+@pytest.mark.parametrize("scale", fam.SCALES)
+def test_every_family_case_validates_and_its_path_fits_the_block(family, scale):
+    for path in _files(family, scale):
+        case = load_case(path)
+        assert case.name == path.stem
+        assert case.test == "cutting"
+        # the checks render makes before packing: the cut stays inside the block, the steps fit max_steps
+        cutter_path(case, case.cutter.diameter_mm * MM / 2)
+        est = fam.estimate(case.model_dump())
+        assert est["steps_est"] < case.run.max_steps, path
+        if scale == "reduced":
+            assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 400_000, (path, est)
+            assert est["particle_steps_est"] <= 8e8, (path, est)  # <= ~7 min at 2 M particle-steps/s
+
+
+def test_full_scale_indentation_keeps_seed000_geometry():
+    cases = _cases("indentation_asymmetric", "full")
+    assert {c.cutter.diameter_mm for c in cases} == {150, 160}
+    assert {c.kinematics.edge_distance_mm for c in cases} == {15, 20, 25}
+    assert {c.material.name for c in cases} == {"concrete", "sandstone"}
+    for c in cases:
+        assert c.cutter.kind == "asymmetric_disc"
+        assert c.cutter.blade_angle_deg == 40 and c.cutter.tip_radius_mm == 1.0
+        assert c.kinematics.mode == "indentation"
+        assert c.specimen.fixed_faces == ["zmin", "ymax"]
+        rho, v, e_b, sig = {"concrete": (2130, 0.03, 1.3, 14), "sandstone": (2450, 0.01, 9, 46)}[c.material.name]
+        assert c.material.density_kg_m3 == rho and c.kinematics.speed_m_s == v
+        assert c.bonds.youngs_modulus_GPa == e_b and c.bonds.tensile_strength_MPa == sig
+        assert c.bonds.shear_strength_MPa == sig and c.bonds.radius_multiplier == 1.2
+
+
+def test_full_scale_linear_and_rotary_keep_seed001_002_geometry():
+    lin = _cases("linear_ccs", "full")
+    assert sorted(c.kinematics.penetration_mm for c in lin) == [1.9, 3.8, 6.4, 7.6]
+    rot = _cases("rotary", "full")
+    assert sorted(c.kinematics.rotary_radius_mm for c in rot) == [250, 500, 1000, 3000]
+    for c in lin + rot:
+        assert c.cutter.kind == "ccs_disc"
+        assert c.cutter.diameter_mm == pytest.approx(17 * 25.4)
+        assert c.cutter.tip_width_mm == 12.5
+        assert c.kinematics.speed_m_s == 0.33 and c.kinematics.spin == "rolling"
+        assert c.material.name == "colorado_red_granite" and c.material.density_kg_m3 == 2600
+    for c in lin:
+        assert c.specimen.length_mm == 304 and c.kinematics.mode == "linear"
+        a, b = c.outputs.steady_window
+        assert 0.5 < a < b <= 1.0  # contact patch in the middle of the rock, as seed 001's 400-600 ms
+    for c in rot:
+        assert c.kinematics.mode == "rotary" and c.kinematics.penetration_mm == 6.4
+
+
+def test_full_scale_odc_keeps_seed003_matrix():
+    cases = {c.name: c for c in _cases("odc", "full")}
+    for c in cases.values():
+        assert (c.cutter.kind, c.cutter.diameter_mm, c.cutter.small_diameter_mm) == ("cone_disc", 20, 10)
+        assert c.cutter.rake_angle_deg == 30 and c.kinematics.penetration_mm == 4
+        assert (c.specimen.length_mm, c.specimen.width_mm, c.specimen.height_mm) == (70, 70, 20)
+        assert c.material.density_kg_m3 == 2730
+    assert {c.cutter.clearance_angle_deg for c in cases.values()} == {0, 9}
+    assert {c.kinematics.speed_m_s for c in cases.values()} == {0.1, 0.5}
+    osc = [c for c in cases.values() if c.kinematics.mode == "oscillation"]
+    assert {c.kinematics.eccentricity_mm / 10 for c in osc} == {0.1, 0.2, 0.4}
+    assert max(c.kinematics.frequency_hz for c in osc) * 60 == 4050
+    assert all(c.kinematics.spin == "shaft" for c in osc)
+    s11 = cases["odc_full_s11"].kinematics  # 1350 rpm, e 4 mm, 0.5 m/s: nu = 0.88 < 1 (backward motion)
+    assert s11.speed_m_s / (s11.eccentricity_mm * MM * 2 * math.pi * s11.frequency_hz) == pytest.approx(0.884, abs=1e-3)
+
+
+def test_reduced_scale_headers_state_the_scaling():
+    for family, must in {
+        "indentation_asymmetric": ["REDUCED SCALE", "Geometry factor 1/3", "Particle size NOT scaled", "Push speed 1 m/s"],
+        "linear_ccs": ["REDUCED SCALE", "Disc geometry factor 1/8", "Penetration factor 1/2", "2 m/s", "E_b 10 GPa"],
+        "rotary": ["REDUCED SCALE", "Geometry factor 1/8", "Penetration factor 1/2", "E_b 10 GPa"],
+        "odc": ["REDUCED SCALE", "Geometry factor 1", "Speed AND frequency x4", "E_b 10 GPa"],
+    }.items():
+        for path in _files(family, "reduced"):
+            head = _header(path)
+            for text in must:
+                assert text in " ".join(head.replace("#", " ").split()), (path, text)
+            assert "placeholder" in head
+
+
+def test_reduced_scale_numbers_follow_the_stated_factors():
+    full = {c.name.replace("_full_", "_"): c for c in _cases("indentation_asymmetric", "full")}
+    for c in _cases("indentation_asymmetric", "reduced"):
+        f = full[c.name.replace("_red_", "_")]
+        assert c.cutter.diameter_mm == pytest.approx(f.cutter.diameter_mm / 3, abs=1e-4)
+        assert c.kinematics.edge_distance_mm == pytest.approx(f.kinematics.edge_distance_mm / 3, abs=1e-4)
+        assert c.cutter.blade_angle_deg == 40
+    for c in _cases("linear_ccs", "reduced") + _cases("rotary", "reduced"):
+        assert c.cutter.diameter_mm == pytest.approx(431.8 / 8, abs=1e-3)
+    assert sorted(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced")) == [0.95, 1.9, 3.2, 3.8]
+    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25, 62.5, 125, 375]
+    fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
+    for c in _cases("odc", "reduced"):
+        f = fulls[c.name.replace("_red_", "_")]
+        assert c.kinematics.speed_m_s == pytest.approx(4 * f.kinematics.speed_m_s)
+        assert c.kinematics.frequency_hz == pytest.approx(4 * f.kinematics.frequency_hz)
+        assert c.kinematics.eccentricity_mm == f.kinematics.eccentricity_mm
+        m = re.search(r"nu = V/\(e w\) = ([0-9.]+)", " ".join(_header(_files("odc", "reduced")[0]).split()))
+        assert m is None or float(m.group(1)) > 0
+
+
+def test_middle_window_puts_the_contact_patch_mid_block():
+    # reduced linear cut lin_red_p6p4: L 26, R 26.99, p 3.2, clearance 0.3 -> travel 22.5 mm, contact-patch
+    # centre (disc centre + half a half chord) at 0.4 L = 10.4 mm when the window opens, 0.6 L at the end
+    R, p, clear = 431.8 / 16, 3.2, 0.3
+    travel = fam.middle_travel(26, R, p, clear)
+    hc = fam.half_chord_mm(R, p)
+    assert hc == pytest.approx(12.74, abs=0.01) and travel == 22.5
+    a, b = fam.middle_window(26, R, p, clear, travel)
+    assert 0.98 <= b <= 1.0
+    assert a * travel - clear - hc / 2 == pytest.approx(10.4, abs=0.12)
+    assert travel - clear - hc / 2 >= 0.6 * 26
+    case = load_case(ROOT / "cases/linear_ccs/reduced/lin_red_p6p4.yaml")
+    assert case.kinematics.travel_mm == travel and list(case.outputs.steady_window) == [a, b]
+
+
+def test_report_table_and_plots(tmp_path):
+    dirs = []
+    for i, (case, fn, fr) in enumerate([("lin_red_p1p9", 100.0, 10.0), ("lin_red_p3p8", 200.0, 30.0)]):
+        d = tmp_path / case / "parsed"
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text(json.dumps({
+            "case": case, "n_grains": 2000 + i, "wall_s": 60.0 + i, "force_normal_N_mean_steady": fn,
+            "force_rolling_N_mean_steady": fr, "rolling_to_normal_ratio_1": fr / fn, "force_normal_N_peak": 3 * fn,
+            "force_side_N_peak": -fn}))
+        dirs.append(d)
+    path = fam.report("linear_ccs", ROOT / "cases/linear_ccs/index.csv", dirs, tmp_path / "out")
+    import pandas as pd
+
+    t = pd.read_csv(path)
+    assert list(t["case"]) == ["lin_red_p1p9", "lin_red_p3p8"]
+    assert list(t["penetration_mm"]) == [0.95, 1.9]
+    assert list(t["n_grains"]) == [2000, 2001] and list(t["wall_s"]) == [60.0, 61.0]
+    assert t["lateral_to_normal_ratio_1"].tolist() == pytest.approx([1 / 3, 1 / 3])
+    assert len(list((tmp_path / "out" / "plots").glob("*.png"))) == 3
+
+
+@pytest.mark.skipif(not SNAKEMAKE.exists() and not shutil.which("snakemake"), reason="snakemake not installed")
+@pytest.mark.parametrize("family", NAMES)
+def test_snakemake_plans_the_reduced_family(family, tmp_path):
+    exe = str(SNAKEMAKE) if SNAKEMAKE.exists() else "snakemake"
+    res = subprocess.run([exe, "-n", f"family_{family}_reduced", "--config", f"results={tmp_path / 'r'}"],
+                         cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    text = " ".join((res.stdout + res.stderr).split())
+    n = len(_files(family, "reduced"))
+    for rule, count in [("pack", n), ("render", n), ("run", n), ("parse", n), ("plot", n),
+                        ("family_aggregate", 1), ("family_report", 1), (f"family_{family}_reduced", 1)]:
+        assert f"{rule} {count}" in text, (rule, count, text[-1500:])
+    for p in _files(family, "reduced"):
+        assert f"{p.stem}/run/in.deck" in text
+    assert "smoke_ucs" not in text

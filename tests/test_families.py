@@ -36,7 +36,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 59 + 2 * len(NAMES)  # 59 case files + index.csv and README.md per family
+    assert len(files) == 83 + 2 * len(NAMES)  # 83 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -48,7 +48,7 @@ def test_case_counts_per_family():
     counts = {(f, s): len(_files(f, s)) for f in NAMES for s in fam.SCALES}
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
-        ("linear_ccs", "full"): 4, ("linear_ccs", "reduced"): 4,
+        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 16,
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
         ("odc", "full"): 10, ("odc", "reduced"): 9,
     }
@@ -88,7 +88,12 @@ def test_full_scale_indentation_keeps_seed000_geometry():
 
 def test_full_scale_linear_and_rotary_keep_seed001_002_geometry():
     lin = _cases("linear_ccs", "full")
-    assert sorted(c.kinematics.penetration_mm for c in lin) == [1.9, 3.8, 6.4, 7.6]
+    # seed 001 Tables 3-4: the 16 (S, p) pairs of its LS-DYNA runs
+    pairs = sorted((c.kinematics.neighbour_spacing_mm, c.kinematics.penetration_mm) for c in lin)
+    assert pairs == sorted([(S, p) for S in (25, 51, 76) for p in (1.9, 3.8, 6.4)]
+                           + [(25, 7.6), (51, 7.6), (76, 7.6), (100, 1.9), (100, 3.8), (100, 6.4), (100, 7.6)])
+    for c in lin:  # the block holds both neighbour grooves
+        assert c.specimen.width_mm >= 2 * c.kinematics.neighbour_spacing_mm + c.cutter.tip_width_mm
     rot = _cases("rotary", "full")
     assert sorted(c.kinematics.rotary_radius_mm for c in rot) == [250, 500, 1000, 3000]
     for c in lin + rot:
@@ -145,7 +150,8 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
         assert c.cutter.blade_angle_deg == 40
     for c in _cases("linear_ccs", "reduced") + _cases("rotary", "reduced"):
         assert c.cutter.diameter_mm == pytest.approx(431.8 / 8, abs=1e-3)
-    assert sorted(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced")) == [0.95, 1.9, 3.2, 3.8]
+    assert sorted(set(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced"))) == [0.95, 1.9, 3.2, 3.8]
+    assert sorted(set(c.kinematics.neighbour_spacing_mm for c in _cases("linear_ccs", "reduced"))) == [3.125, 6.375, 9.5, 12.5]
     assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25, 62.5, 125, 375]
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
     for c in _cases("odc", "reduced"):
@@ -158,7 +164,7 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
 
 
 def test_middle_window_puts_the_contact_patch_mid_block():
-    # reduced linear cut lin_red_p6p4: L 26, R 26.99, p 3.2, clearance 0.3 -> travel 22.5 mm, contact-patch
+    # reduced linear cut lin_red_s51_p6p4: L 26, R 26.99, p 3.2, clearance 0.3 -> travel 22.5 mm, contact-patch
     # centre (disc centre + half a half chord) at 0.4 L = 10.4 mm when the window opens, 0.6 L at the end
     R, p, clear = 431.8 / 16, 3.2, 0.3
     travel = fam.middle_travel(26, R, p, clear)
@@ -168,13 +174,13 @@ def test_middle_window_puts_the_contact_patch_mid_block():
     assert 0.98 <= b <= 1.0
     assert a * travel - clear - hc / 2 == pytest.approx(10.4, abs=0.12)
     assert travel - clear - hc / 2 >= 0.6 * 26
-    case = load_case(ROOT / "cases/linear_ccs/reduced/lin_red_p6p4.yaml")
+    case = load_case(ROOT / "cases/linear_ccs/reduced/lin_red_s51_p6p4.yaml")
     assert case.kinematics.travel_mm == travel and list(case.outputs.steady_window) == [a, b]
 
 
 def test_report_table_and_plots(tmp_path):
     dirs = []
-    for i, (case, fn, fr) in enumerate([("lin_red_p1p9", 100.0, 10.0), ("lin_red_p3p8", 200.0, 30.0)]):
+    for i, (case, fn, fr) in enumerate([("lin_red_s25_p1p9", 100.0, 10.0), ("lin_red_s25_p3p8", 200.0, 30.0)]):
         d = tmp_path / case / "parsed"
         d.mkdir(parents=True)
         (d / "summary.json").write_text(json.dumps({
@@ -186,7 +192,7 @@ def test_report_table_and_plots(tmp_path):
     import pandas as pd
 
     t = pd.read_csv(path)
-    assert list(t["case"]) == ["lin_red_p1p9", "lin_red_p3p8"]
+    assert list(t["case"]) == ["lin_red_s25_p1p9", "lin_red_s25_p3p8"]
     assert list(t["penetration_mm"]) == [0.95, 1.9]
     assert list(t["n_grains"]) == [2000, 2001] and list(t["wall_s"]) == [60.0, 61.0]
     assert t["lateral_to_normal_ratio_1"].tolist() == pytest.approx([1 / 3, 1 / 3])

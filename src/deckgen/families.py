@@ -19,7 +19,7 @@ Numbers come from the seed papers (``/work/shared/seeds``; tables in ``/work/sha
   0.03 m/s (concrete) and 0.01 m/s (sandstone), back and right faces fixed (sec. 3.3, Tables 2-3).
 * ``linear_ccs`` - seed 001 (Fattahi): 17-inch (432 mm) CCS disc, penetration 1.9/3.8/6.4/7.6 mm
   (Tables 3-4), 0.33 m/s, rolling (1.5 rad/s ~ v/R), rock 304 mm long, Colorado red granite. The
-  neighbour discs (spacing S) are not in the spec yet: single-disc cases, spacing is a TODO.
+  at the 16 (spacing S, penetration p) pairs of its Tables 3-4, neighbours as pre-cut grooves at +-S.
 * ``rotary`` - seed 002 (Farrokh): the same disc on a circle of radius r = 250/500/1000/3000 mm
   (Table 2), p = 6.4 mm.
 * ``odc`` - seed 003 (Grashof thesis): cone disc of radius 10 mm (diameters 20/10 mm), rake 30 deg,
@@ -251,7 +251,11 @@ CCS_D_MM = 431.8  # 17 inch
 CCS_TIP_WIDTH_MM = 12.5  # seed 002 sec. 3 (12.5 and 20 mm tips); seed 001 shows the A30581 only in Fig. 11
 CCS_HUB_MM = 60.0  # not in the seeds (assumed; does not touch the rock at p <= 7.6 mm)
 SEED001_PENETRATIONS = (1.9, 3.8, 6.4, 7.6)  # Table 3 (text: 2.5, 5.1, 6.4) and Table 4 (7.6)
-SEED001_SPACINGS_TODO = (25, 51, 76, 100)  # Tables 3-4; needs kinematics.neighbour_spacing_mm
+SEED001_SPACINGS = (25, 51, 76, 100)
+#: the 16 (spacing S, penetration p) pairs of seed 001's LS-DYNA runs, mm: Table 3 (S 25/51/76 x p
+#: 1.9/3.8/6.4, Gertsch et al. 2007's tests) and Table 4 (S 25/51/76 at p 7.6; S 100 at all four p)
+SEED001_PAIRS = tuple((S, p) for S in (25, 51, 76) for p in (1.9, 3.8, 6.4)) + (
+    (25, 7.6), (51, 7.6), (76, 7.6), (100, 1.9), (100, 3.8), (100, 6.4), (100, 7.6))
 REDUCED_DISC = 1 / 8  # linear_ccs and rotary: disc geometry factor
 REDUCED_PEN = 1 / 2  # linear_ccs and rotary: penetration factor (grains are not scaled)
 
@@ -271,27 +275,29 @@ def linear_ccs() -> list[CaseDef]:
     rock = "colorado_red_granite"
     out: list[CaseDef] = []
     for scale in SCALES:
-        for p_full in SEED001_PENETRATIONS:
+        for S_full, p_full in SEED001_PAIRS:
             if scale == "full":
                 f, fp, R = 1.0, 1.0, CCS_D_MM / 2
                 p = p_full
-                L, W, H = 304, 120, 60
+                S = S_full
+                L, W, H = 304, max(120, 2 * S + 60), 60
                 clear = 1.0
                 travel = middle_travel(L, R, p, clear)
-                name = f"lin_full_p{_tag(p)}"
+                name = f"lin_full_s{S_full}_p{_tag(p)}"
                 packing = {"radius_min_mm": 0.5, "radius_max_mm": 0.75}
                 bonds = placeholder_bonds(rock, 40)
                 kin = {"mode": "linear", "speed_m_s": 0.33, "penetration_mm": p, "travel_mm": travel,
-                       "start_clearance_mm": clear, "spin": "rolling"}
+                       "start_clearance_mm": clear, "spin": "rolling", "neighbour_spacing_mm": S}
                 outputs = {"series_every": 2000, "bond_state_every": 200000,
                            "steady_window": middle_window(L, R, p, clear, travel)}
                 header = [
-                    f"Seed 001 (Fattahi), linear cutting of Colorado red granite, FULL SCALE (for clusters): p = {p} mm.",
+                    f"Seed 001 (Fattahi), linear cutting of Colorado red granite, FULL SCALE (for clusters): S = {S} mm, p = {p} mm.",
                     "17-inch (431.8 mm) CCS disc, tip width 12.5 mm (seed 002 sec. 3; A30581 profile of seed 001 Fig. 11",
                     "not transcribed), flank 20 deg, tip radius 1 mm, hub 60 mm (assumed). 0.33 m/s with rolling spin",
                     "(seed 001: 0.33 mm/ms, 0.0015 rad/ms = v/R). Rock 304 mm long (seed 001 sec. 5), 120 x 60 mm",
-                    "section (assumed; Fig. 9 not transcribed); bottom and far end fixed. Single disc: the three-disc",
-                    "spacing S = 25/51/76/100 mm needs kinematics.neighbour_spacing_mm (TODO, cases/linear_ccs/README.md).",
+                    f"section widened to {W} mm for the neighbours (assumed; Fig. 9 not transcribed); bottom and far end",
+                    "fixed. Neighbours: the grooves of the same disc at +-S are cut out of the block before the cut",
+                    "(kinematics.neighbour_spacing_mm; seed 001's three discs cut at once, this is the relieved state).",
                     "Steady window: contact patch in the middle 40-60 % of the rock (seed 001: 400-600 ms), clipped to",
                     "the travel, which ends there. Grains r 0.5-0.75 mm: p = 1.9 mm is only 1.5 grain diameters (seed 001 used 0.3 mm SPG",
                     "particles; a DEM at that size is ~30x more grains). Bonds: placeholder (E_b 40 GPa, strengths",
@@ -300,26 +306,28 @@ def linear_ccs() -> list[CaseDef]:
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
                 p = _r(p_full * fp, 3)
-                L, W, H = 26, 20, 12
+                S = _r(S_full * f, 4)
+                L, W, H = 26, max(20, _r(2 * S + 8, 3)), 12
                 clear = 0.3
                 travel = middle_travel(L, R, p, clear)
-                name = f"lin_red_p{_tag(p_full)}"
+                name = f"lin_red_s{S_full}_p{_tag(p_full)}"
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds = placeholder_bonds(rock, 10)
                 kin = {"mode": "linear", "speed_m_s": 2.0, "penetration_mm": p, "travel_mm": travel,
-                       "start_clearance_mm": clear, "spin": "rolling"}
+                       "start_clearance_mm": clear, "spin": "rolling", "neighbour_spacing_mm": S}
                 outputs = {"series_every": 100, "bond_state_every": 5000,
                            "steady_window": middle_window(L, R, p, clear, travel)}
                 header = [
-                    f"Seed 001 (Fattahi), linear cutting, REDUCED SCALE (2 cores): full-scale p = {p_full} mm.",
+                    f"Seed 001 (Fattahi), linear cutting, REDUCED SCALE (2 cores): full-scale S = {S_full} mm, p = {p_full} mm.",
                     f"Disc geometry factor 1/8: CCS D {_r(CCS_D_MM * f)} mm (17 in), tip width {_r(CCS_TIP_WIDTH_MM * f)} mm (12.5),",
                     f"hub {_r(CCS_HUB_MM * f)} mm; tip radius 0.3 mm (= shell radius). Penetration factor 1/2, not 1/8: p = {p} mm,",
                     "because grains are not scaled (r 0.7-1.0 mm; 1/8 would put p below one grain), so p/R is 4x the",
-                    f"seed's (contact angle ~2x). Block 26 x 20 x 12 mm (not 304/8 = 38 mm long), {travel} mm of travel; steady",
+                    f"seed's (contact angle ~2x). Block 26 x {W} x 12 mm (not 304/8 = 38 mm long), {travel} mm of travel; steady",
                     "window as full scale (contact patch in the middle 40-60 % of the block). 2 m/s (6x the seed's 0.33)",
                     "with rolling spin, for ~1e5 steps. Bonds softened to E_b 10 GPa (dt x2; placeholder strengths",
                     "scaled from the smoke UCS to CRG's 158 MPa) until results/calibration/colorado_red_granite/card.yaml",
-                    "exists. Single disc (spacing TODO). Forces scale ~ length^2; Fr/Fn vs p is the trend to compare.",
+                    f"exists. Neighbour grooves at +-S = {S} mm (S x 1/8, only {_r(S / 1.7, 1)} grain diameters) cut out before the cut.",
+                    "Forces scale ~ length^2; Fr/Fn vs p and F_n vs S are the trends to compare.",
                 ]
             contact = {"youngs_modulus_GPa": ROCKS[rock]["youngs_modulus_GPa"], "cutter_friction": 0.3}
             block = {"length_mm": L, "width_mm": W, "height_mm": H, "fixed_faces": ["zmin", "xmax"]}
@@ -328,7 +336,7 @@ def linear_ccs() -> list[CaseDef]:
                 data["run"] = {"max_steps": _max_steps(data)}
             out.append(CaseDef(fam, scale, name, header, data, {
                 "rock": rock, "penetration_full_mm": p_full, "penetration_mm": p, "disc_diameter_mm": _r(CCS_D_MM * f),
-                "spacing_mm": "", "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp}))
+                "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp}))
     return out
 
 
@@ -362,7 +370,7 @@ def rotary() -> list[CaseDef]:
                     "0.33 m/s with rolling spin as seed 001 (seed 002 gives none). Block 240 x 220 x 60 mm (seed 002",
                     f"Fig. 2 not transcribed): wide enough for the {travel} mm arc at r = 250 mm; travel and steady window",
                     "as linear_ccs (contact patch in the middle 40-60 % of the block length). Grains r 0.5-0.75 mm;",
-                    "placeholder bonds (as linear_ccs full). Single disc: spacing S is a TODO (linear_ccs README).",
+                    "placeholder bonds (as linear_ccs full). Single disc (no neighbour grooves).",
                 ]
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
@@ -530,20 +538,18 @@ def readme_text(family: str, cases: list[CaseDef]) -> str:
         f"Run the reduced set: `snakemake --cores 2 family_{family}_reduced` (results in `results/families/{family}_reduced/`).",
         "",
     ]
-    if family in ("linear_ccs", "rotary"):
+    if family == "linear_ccs":
         lines += [
-            "## TODO: cutter spacing",
+            "## Cutter spacing",
             "",
-            "Seed 001 cuts with three discs at spacing S = " + "/".join(map(str, SEED001_SPACINGS_TODO))
-            + " mm (Tables 3-4) and reports the central disc; seed 002 uses S = 25/51/76 mm.",
-            "The case spec has no neighbour discs yet (`kinematics.neighbour_spacing_mm` is being added on",
-            "another branch). Until it lands these cases are single discs, the spacing column of `index.csv`",
-            "is empty, and the spacing factor (normal force rising with S, the 80 %-capacity optimum) cannot be",
-            "run. When it lands: add `neighbour_spacing_mm` to the grid in `src/deckgen/families.py`",
-            "(`SEED001_SPACINGS_TODO`; reduced: S x 1/8 for the geometry, widening the block to hold three",
-            "grooves), regenerate, and extend the tests in `tests/test_families.py`.",
+            "Seed 001 cuts with three discs at spacing S = " + "/".join(map(str, SEED001_SPACINGS))
+            + " mm (Tables 3-4) and reports the central disc. Here the neighbours' grooves at +-S are cut out",
+            "of the block before the cut (`kinematics.neighbour_spacing_mm`): the relieved state between",
+            "neighbours that have already passed, not three discs cutting at once.",
             "",
         ]
+    if family == "rotary":
+        lines += ["Single disc on its circular path; `kinematics.neighbour_spacing_mm` adds neighbour grooves.", ""]
     return "\n".join(lines)
 
 
@@ -565,8 +571,8 @@ def family_files(root: Path) -> dict[Path, str]:
 PLOTS: dict[str, tuple[str, list[str], list[str]]] = {
     "indentation_asymmetric": ("cut_spacing_mm", ["rock", "disc_diameter_mm"],
                                ["force_normal_N_peak", "lateral_to_normal_ratio_1"]),
-    "linear_ccs": ("penetration_mm", [], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
-                                           "rolling_to_normal_ratio_1"]),
+    "linear_ccs": ("penetration_mm", ["spacing_mm"], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
+                                                     "rolling_to_normal_ratio_1"]),
     "rotary": ("rotary_radius_mm", [], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
                                         "force_side_N_mean_steady"]),
     "odc": ("frequency_hz", ["eccentricity_ratio_1", "speed_m_s"], ["force_magnitude_N_mean_steady",

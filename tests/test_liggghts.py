@@ -265,6 +265,9 @@ def test_bonded_ucs_deck_golden_and_grammar(tmp_path):
     assert bc["break_type"] == 1 and bc["break"] == [b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA]
     assert "atom_style      hybrid granular bond/gran n_bondtypes 1 bonds_per_atom 16 disableNormalContact 1" in text
     assert spec["derived"]["bonded"] is True
+    # broken-bond output: the fork's per-bond broken flag, sampled with the series
+    assert "compute         bst all property/local batom1 batom2 btype bbondbroken" in text
+    assert "dump            bst all local ${series_every} bonds.dump" in text
     golden = DATA / "liggghts" / "tiny_ucs_bonded.in.liggghts"
     if os.environ.get("DECKGEN_REGEN_GOLDEN"):
         golden.write_text(text)

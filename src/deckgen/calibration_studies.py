@@ -120,7 +120,8 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
     p = MicroParams(youngs_modulus_GPa=b["youngs_modulus_GPa"], tensile_strength_MPa=b["tensile_strength_MPa"],
                     shear_strength_MPa=b["shear_strength_MPa"], friction=c.get("friction", 0.5),
                     rolling_friction=c.get("rolling_friction", 0.1), radius_multiplier=b.get("radius_multiplier", 1.0),
-                    gap_tolerance=b.get("gap_tolerance", 0.05))
+                    gap_tolerance=b.get("gap_tolerance", 0.05),
+                    contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"])
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 

@@ -128,13 +128,17 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
 
 def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
                       command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
-    """The calibrated point at the card's platen speeds and at half of them."""
+    """The calibrated point at the card's platen speeds and at half of them (same replicate packings
+    as the calibration's evaluations, so the full-speed row reproduces the card's achieved values)."""
     card, p, base, ucs, bts = _card_setup(card_path)
     rows = []
     for factor in (1.0, 0.5):
         u = {**ucs, "platen_speed_m_s": ucs["platen_speed_m_s"] * factor}
         b = {**bts, "platen_speed_m_s": bts["platen_speed_m_s"] * factor}
-        ev = DemEvaluator(base, u, b, out / "work" / f"speed_{factor:g}", cache=cache, command=command, name=card.rock, parallel=parallel)
+        # the calibration's own evaluation (its replicate packings), at full and half speed
+        ev = DemEvaluator(base, u, b, out / "work" / f"speed_{factor:g}", cache=cache, command=command, name=card.rock,
+                          parallel=parallel, ucs_packings=card.calibration.ucs_packings,
+                          bts_packings=card.calibration.bts_packings)
         row = _row(f"speed x{factor:g}", ev, p)
         row.update({"rock": card.rock, "speed_factor": factor, "ucs_speed_m_s": u["platen_speed_m_s"],
                     "bts_speed_m_s": b["platen_speed_m_s"]})
@@ -150,7 +154,8 @@ def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
 
 def seeds_study(card_path: Path, out: Path, seeds: list[int], *, cache: Path | None = None,
                 command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
-    """The calibrated point on new packing seeds (one UCS + one BTS packing per seed)."""
+    """The calibrated point on new packing seeds: one UCS and one BTS test per seed, so the scatter is
+    that of single specimens (the calibration itself averages ``bts_packings`` discs)."""
     card, p, base, ucs, bts = _card_setup(card_path)
     rows = []
     for seed in seeds:
@@ -179,8 +184,9 @@ def scatter(df: pd.DataFrame) -> dict[str, float]:
 def results_table(cards: list[Path], studies: Path) -> str:
     """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
     head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
-            "| E_b GPa | σ_c MPa | τ_c/σ_c | seeds: UCS, BTS, E mean ± sd (CV) | half speed: ΔUCS, ΔBTS |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+            "| E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) | new-seed mean vs target "
+            "| half speed: ΔUCS, ΔBTS |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for path in cards:
         try:
@@ -190,17 +196,20 @@ def results_table(cards: list[Path], studies: Path) -> str:
             continue
         p = card.provenance
         if p is None or card.calibrated is None:
-            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | |")
+            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | |")
             continue
         a, b = p.achieved, card.calibrated.bonds
         nu = "–"
         sfile = studies / f"seeds_{card.rock}.csv"
-        seeds = "–"
+        seeds = seed_err = "–"
         if sfile.is_file():
             s = scatter(pd.read_csv(sfile))
             seeds = (f"{s['ucs_Pa_mean'] / MPA:.3g} ± {s['ucs_Pa_std'] / MPA:.2g} ({s['ucs_Pa_cv']:.1%}), "
                      f"{s['bts_Pa_mean'] / MPA:.3g} ± {s['bts_Pa_std'] / MPA:.2g} ({s['bts_Pa_cv']:.1%}), "
                      f"{s['E_Pa_mean'] / GPA:.3g} ± {s['E_Pa_std'] / GPA:.2g} ({s['E_Pa_cv']:.1%}); n = {s['n']:.0f}")
+            tg = card.targets.as_pa()
+            seed_err = (f"{s['ucs_Pa_mean'] / tg['ucs'] - 1:+.1%}, {s['bts_Pa_mean'] / tg['bts'] - 1:+.1%}, "
+                        f"{s['E_Pa_mean'] / tg['E'] - 1:+.1%}")
             sd = pd.read_csv(sfile)
             if "poisson_ratio_1" in sd:
                 nu = f"{sd['poisson_ratio_1'].mean():.2f}"
@@ -215,7 +224,9 @@ def results_table(cards: list[Path], studies: Path) -> str:
             f"{a.youngs_modulus_GPa:.4g} ({a.youngs_modulus_error:+.1%}) | {nu} | {a.ucs_MPa / a.bts_MPa:.3g} | "
             f"{p.evaluations}{'' if p.converged else ' (not converged)'} | {p.wall_s / 60:.1f} | "
             f"{b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
-            f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {seeds} | {qs} |")
+            f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {b.get('gap_tolerance', 0.05):.3g} | "
+            f"{card.calibrated.contact.get('youngs_modulus_GPa', b['youngs_modulus_GPa']) / b['youngs_modulus_GPa']:.3g} | "
+            f"{seeds} | {seed_err} | {qs} |")
     return head + "\n".join(lines) + "\n"
 
 

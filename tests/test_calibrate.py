@@ -45,7 +45,12 @@ def test_target_cards_match_rock_table():
         rows = {r["rock"]: r for r in csv.DictReader(ln for ln in table.read_text().splitlines() if not ln.startswith("#"))}
     for rock in ROCKS:
         card = _card(rock)
-        assert card.rock == rock and card.calibrated is None and card.provenance is None
+        assert card.rock == rock
+        if card.provenance is not None:  # a calibrated card: it met its tolerance and says how
+            a = card.provenance.achieved
+            assert card.provenance.converged and card.calibrated is not None
+            assert max(abs(a.ucs_error), abs(a.bts_error), abs(a.youngs_modulus_error)) <= card.provenance.tolerance
+            assert a.ucs_MPa == pytest.approx(card.targets.ucs_MPa * (1 + a.ucs_error), rel=1e-3)
         assert "seed 00" in card.targets.citation
         if rows:  # the shared rock table is there: the cards transcribe it
             r = rows[rock]

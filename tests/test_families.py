@@ -214,3 +214,18 @@ def test_snakemake_plans_the_reduced_family(family, tmp_path):
     for p in _files(family, "reduced"):
         assert f"{p.stem}/run/in.deck" in text
     assert "smoke_ucs" not in text
+
+
+def test_report_cli_takes_run_folders_after_the_options(tmp_path):
+    """The family_report rule passes the parsed folders after --family/--index/--out."""
+    d = tmp_path / "lin_red_s25_p1p9" / "parsed"
+    d.mkdir(parents=True)
+    (d / "summary.json").write_text(json.dumps({"case": "lin_red_s25_p1p9", "n_grains": 2000, "wall_s": 60.0,
+                                                "force_normal_N_mean_steady": 100.0}))
+    rc = fam.main(["report", "--family", "linear_ccs", "--index", str(ROOT / "cases/linear_ccs/index.csv"),
+                   "--out", str(tmp_path / "out"), str(d)])
+    assert rc == 0
+    import pandas as pd
+
+    assert list(pd.read_csv(tmp_path / "out" / "family_table.csv")["case"]) == ["lin_red_s25_p1p9"]
+

@@ -671,7 +671,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--index", help="report: the family's index.csv")
     p.add_argument("--out", help="report: output folder (family_table.csv, plots/)")
     p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json)")
-    args = p.parse_args(argv)
+    args = p.parse_intermixed_args(argv)  # run folders may follow the options, as in rules/families.smk
     if args.command == "report":
         if not (args.family and args.index and args.out):
             p.error("report needs --family, --index and --out")

@@ -203,14 +203,14 @@ def results_table(cards: list[Path], studies: Path) -> str:
         sfile = studies / f"seeds_{card.rock}.csv"
         seeds = seed_err = "–"
         if sfile.is_file():
-            s = scatter(pd.read_csv(sfile))
+            sd = pd.read_csv(sfile)
+            s = scatter(sd)
             seeds = (f"{s['ucs_Pa_mean'] / MPA:.3g} ± {s['ucs_Pa_std'] / MPA:.2g} ({s['ucs_Pa_cv']:.1%}), "
                      f"{s['bts_Pa_mean'] / MPA:.3g} ± {s['bts_Pa_std'] / MPA:.2g} ({s['bts_Pa_cv']:.1%}), "
                      f"{s['E_Pa_mean'] / GPA:.3g} ± {s['E_Pa_std'] / GPA:.2g} ({s['E_Pa_cv']:.1%}); n = {s['n']:.0f}")
             tg = card.targets.as_pa()
             seed_err = (f"{s['ucs_Pa_mean'] / tg['ucs'] - 1:+.1%}, {s['bts_Pa_mean'] / tg['bts'] - 1:+.1%}, "
                         f"{s['E_Pa_mean'] / tg['E'] - 1:+.1%}")
-            sd = pd.read_csv(sfile)
             if "poisson_ratio_1" in sd:
                 nu = f"{sd['poisson_ratio_1'].mean():.2f}"
         qfile = studies / f"quasistatic_{card.rock}.csv"

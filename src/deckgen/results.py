@@ -570,7 +570,7 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         intercept = float(ym - slope * xm)
     # Poisson's ratio: -d(lateral strain)/d(axial strain) over the same pre-peak window (UCS only)
     nu = _nan()
-    lat = ts["lateral_strain_1"].to_numpy(dtype=float) if "lateral_strain_1" in ts else np.full(len(ts), np.nan)
+    lat = ts["lateral_strain_1"].to_numpy(dtype=float)  # NaN for decks without it (BTS, older UCS decks)
     if test == "ucs" and sel.sum() >= 2 and np.ptp(strain[sel]) > 0 and np.isfinite(lat[sel]).all():
         nu = float(np.polyfit(strain[sel], lat[sel], 1)[0])  # compression-positive axial, expansion-positive lateral
     out["poisson_ratio_1"] = nu

@@ -218,3 +218,10 @@ def test_rotary_path_moves_the_shell_rigidly(tmp_path, cache):
            for i, x, y, z in final[["id", "x", "y", "z"]].itertuples(index=False)]
     # write_dump prints 6 significant digits (1e-7 m here); a wrong transform is off by millimetres
     assert len(err) == len(init) and max(err) < 2e-7
+    # the Python copy of the motion (used to drop shell spheres that never come near the rock) agrees
+    from deckgen.deck import cutter_world_points
+
+    ids = final["id"].to_numpy()
+    rel = np.array([init[int(i)] - c0 for i in ids])
+    got = cutter_world_points(rel, cut, t_end)
+    assert np.abs(got - final[["x", "y", "z"]].to_numpy()).max() < 2e-7

@@ -124,3 +124,88 @@ def test_specimen_data_is_deterministic(tmp_path):
         regen.render_golden("tiny_ucs", out, tmp_path / f"cache{k}")
         digests.append(hashlib.sha256((out / "specimen.data").read_bytes()).hexdigest())
     assert digests[0] == digests[1]
+
+
+def _rolling_path(R=6e-3, V=2.0, duration=5e-3):
+    return dict(xc0=-4e-3, yc0=0.0, zc0=8e-3 - 1.5e-3 + R, V=V, ecc=0.0, omega=0.0, spin_rate=V / R, duration=duration,
+                travel=V * duration, penetration=1.5e-3, radius=R, mode_indent=0.0, yaw_rate=0.0, rotary_radius=0.0,
+                axis_x=0.0, axis_y=0.0)
+
+
+def test_cutter_motion_rolls_without_slip():
+    """The Python copy of the deck's motion: the lowest rim point of a rolling disc is at rest, the top moves at 2V."""
+    import numpy as np
+
+    from deckgen.deck import cutter_world_points
+
+    path = _rolling_path()
+    R, V, h = path["radius"], path["V"], 1e-9
+    rel = np.array([[0.0, 0.0, -R], [0.0, 0.0, R], [R, 0.0, 0.0]])
+    vel = (cutter_world_points(rel, path, h) - cutter_world_points(rel, path, -h)) / (2 * h)
+    assert vel[0] == pytest.approx([0.0, 0.0, 0.0], abs=1e-5)
+    assert vel[1] == pytest.approx([2 * V, 0.0, 0.0], abs=1e-5)
+    assert vel[2] == pytest.approx([V, 0.0, -V], abs=1e-5)  # front point moves down as the disc rolls forward
+    # after a quarter turn the front point is at the bottom, a quarter turn of travel further on
+    t = (math.pi / 2) * R / V
+    assert cutter_world_points(rel[2:], path, t)[0] == pytest.approx(
+        [path["xc0"] + V * t, 0.0, path["zc0"] - R], abs=1e-12)
+
+
+def test_near_rock_mask_matches_dense_sampling():
+    """Kept shell points are exactly those that come within the margin of the block (checked at 20x the samples)."""
+    import numpy as np
+
+    from deckgen.deck import cutter_world_points, near_rock_mask
+
+    rng = np.random.default_rng(3)
+    R = 6e-3
+    ang = rng.uniform(0, 2 * math.pi, 3000)
+    rel = np.column_stack([R * np.cos(ang), rng.uniform(-1e-3, 1e-3, 3000), R * np.sin(ang)])
+    path = _rolling_path(R=R)
+    lo, hi = np.array([0.0, -5e-3, 0.0]), np.array([20e-3, 5e-3, 8e-3])
+    margin = 1e-3
+    keep = near_rock_mask(rel, path, lo, hi, margin)
+    dmin = np.full(len(rel), np.inf)
+    for t in np.linspace(0, path["duration"], 4001):
+        p = cutter_world_points(rel, path, float(t))
+        dmin = np.minimum(dmin, np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0), axis=1))
+    assert not keep[dmin > margin * 1.01].any()
+    assert keep[dmin < margin * 0.99].all()
+    # a 12 mm disc rolling 10 mm (1.7 rad) at 1.5 mm depth keeps a third of its rim (measured 0.36), not all of it
+    assert 0.25 < keep.mean() < 0.5, keep.mean()
+
+
+def test_near_rock_shell_keeps_the_contact_band(tmp_path):
+    """tiny_cut with shell_coverage near_rock: fewer spheres, all of them on the lower part of the rolling disc."""
+    import numpy as np
+    import yaml
+
+    from deckgen.deck import render_case
+    from deckgen.spec import load_case
+
+    regen = _regen()
+    data = yaml.safe_load((ROOT / "tests" / "data" / "cases" / "tiny_cut.yaml").read_text())
+    data["cutter"]["shell_coverage"] = "near_rock"
+    data["cutter"]["shell_margin_mm"] = 1.0
+    (tmp_path / "tiny_cut.yaml").write_text(yaml.safe_dump(data))
+    case = load_case(tmp_path / "tiny_cut.yaml")
+    regen.install_fixture(case, "tiny_cut", tmp_path / "cache")
+    spec = render_case(case, tmp_path / "run", cache=tmp_path / "cache", progress=False, command=["false"])
+    d = spec["derived"]
+    assert d["n_shell"] < 0.9 * d["n_shell_full_cover"]
+    lines = (tmp_path / "run" / "specimen.data").read_text().split("Atoms # bpm/sphere")[1].split("Bonds")[0].strip().splitlines()
+    xyz = np.array([[float(v) for v in ln.split()[5:8]] for ln in lines if ln.split()[2] == "2"])
+    assert len(xyz) == d["n_shell"]
+    # where the kept spheres are at the end of the cut: they reach the disc's lowest level there (the cut floor)
+    from deckgen.deck import cutter_world_points
+
+    cut = d["cutter"]
+    c0 = np.array([cut["xc0"], cut["yc0"], cut["zc0"]])
+    end = cutter_world_points(xyz - c0, cut, cut["duration"])
+    zc_end = cut["zc0"] + cut["ecc"] * math.sin(cut["omega"] * cut["duration"])
+    xc_end = cut["xc0"] + cut["V"] * cut["duration"] + cut["ecc"] * (math.cos(cut["omega"] * cut["duration"]) - 1)
+    low = np.argmin(end[:, 2])
+    assert end[low, 2] == pytest.approx(zc_end - cut["radius"] + d["shell_radius_m"], abs=0.2e-3)
+    assert xc_end - 0.5e-3 < end[low, 0] < xc_end + 1.5e-3  # just ahead of the centre: the front part is in the block
+    # and none is further than the margin (plus the sphere radius) from the block at every time
+    assert d["shell_margin_m"] == pytest.approx(1e-3)

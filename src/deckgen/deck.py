@@ -163,6 +163,45 @@ def build_cutter_files(case: Case, out: Path) -> dict[str, Any]:
     return {"mesh": true, "shell_mesh": shell, "summary": cutter_summary(true)}
 
 
+def cutter_world_points(rel: np.ndarray, path: dict[str, float], t: float) -> np.ndarray:
+    """Where points fixed to the cutter (``rel``: offsets from the start centre) are at time ``t``.
+
+    The same rigid motion as the ``fix move variable`` block of ``templates/lammps/cutting.lmp.j2``:
+    centre path plus spin about y, and for the rotary path a yaw about the vertical axis (ax_x, ax_y).
+    """
+    X, Y, Z = rel[:, 0], rel[:, 1], rel[:, 2]
+    th = path["spin_rate"] * t
+    X1 = X * math.cos(th) + Z * math.sin(th)
+    Z1 = -X * math.sin(th) + Z * math.cos(th)
+    if path["rotary_radius"]:
+        r, phi = path["rotary_radius"], path["yaw_rate"] * t
+        qx = X1 * math.cos(phi) - (Y - r) * math.sin(phi)
+        qy = X1 * math.sin(phi) + (Y - r) * math.cos(phi)
+        return np.column_stack([path["axis_x"] + qx, path["axis_y"] + qy, path["zc0"] + Z1])
+    V, e, w, ind = path["V"], path["ecc"], path["omega"], path["mode_indent"]
+    xc = path["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0))
+    zc = path["zc0"] - ind * V * t + (1 - ind) * e * math.sin(w * t)
+    return np.column_stack([xc + X1, path["yc0"] + Y, zc + Z1])
+
+
+def near_rock_mask(rel: np.ndarray, path: dict[str, float], lo: np.ndarray, hi: np.ndarray, margin: float) -> np.ndarray:
+    """Cutter-fixed points that come within ``margin`` of the box [lo, hi] at some time of the motion.
+
+    The motion is sampled so that no point moves more than margin/4 between samples; a point that
+    never comes that close cannot touch a grain of the block (or a chip lifted less than ``margin``).
+    """
+    rmax = float(np.sqrt((rel**2).sum(axis=1)).max()) if len(rel) else 0.0
+    speed = (path["V"] + path["ecc"] * path["omega"] + abs(path["spin_rate"]) * rmax
+             + path["yaw_rate"] * (path["rotary_radius"] + rmax))
+    n = int(min(20000, math.ceil(speed * path["duration"] / (0.25 * margin)))) + 2
+    keep = np.zeros(len(rel), bool)
+    for t in np.linspace(0.0, path["duration"], n):
+        p = cutter_world_points(rel, path, float(t))
+        d = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+        keep |= (d * d).sum(axis=1) < margin * margin
+    return keep
+
+
 def shell_points(shell_mesh, spacing: float, seed: int) -> np.ndarray:
     """Sphere centres on the offset surface, no two closer than ``spacing``, gaps ~<= 1.5 spacing.
 
@@ -447,6 +486,16 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             raise SpecError(f"cutter.shell_radius_mm: {case.cutter.shell_radius_mm:g} mm is more than half the smallest "
                             f"grain radius (fix: use <= {0.5 * float(r.min()) / MM:.3g} mm)")
         pts = shell_points(files["shell_mesh"], case.cutter.shell_spacing * 2 * rs, seed=case.packing.seed)
+        n_shell_full = len(pts)
+        if case.cutter.shell_coverage == "near_rock":
+            margin = (case.cutter.shell_margin_mm * MM if case.cutter.shell_margin_mm is not None
+                      else 6.0 * float(r_full.max()))
+            lo_b, hi_b = (atoms.x - r[:, None]).min(axis=0), (atoms.x + r[:, None]).max(axis=0)
+            pts = pts[near_rock_mask(pts, path, lo_b, hi_b, margin + rs)]
+            if len(pts) == 0:
+                raise SpecError("cutter.shell_coverage: near_rock keeps no shell sphere: the cutter never comes within "
+                                f"{margin / MM:g} mm of the block (fix: check kinematics.penetration_mm and travel_mm)")
+            derived.update(shell_margin_m=margin, n_shell_full_cover=n_shell_full)
         centre = np.array([path["xc0"], path["yc0"], path["zc0"]])
         pts = pts + centre
         n_shell = len(pts)

@@ -200,7 +200,7 @@ def indentation_asymmetric() -> list[CaseDef]:
                     block = {"length_mm": _r(100 * f), "width_mm": _r(75 * f), "height_mm": _r(60 * f),
                              "fixed_faces": ["zmin", "ymax"]}
                     cutter = {"kind": "asymmetric_disc", "diameter_mm": _r(D * f), "blade_angle_deg": 40,
-                              "tip_radius_mm": _r(1.0 * f), "hub_width_mm": _r(20 * f)}
+                              "tip_radius_mm": _r(1.0 * f), "hub_width_mm": _r(20 * f), "shell_coverage": "near_rock"}
                     if scale == "full":
                         packing = dict(full_packing[rock])
                         bonds = dict(seed_bonds[rock])
@@ -262,7 +262,7 @@ REDUCED_PEN = 1 / 2  # linear_ccs and rotary: penetration factor (grains are not
 
 def _ccs_cutter(f: float, scale: str) -> dict[str, Any]:
     c = {"kind": "ccs_disc", "diameter_mm": _r(CCS_D_MM * f), "tip_width_mm": _r(CCS_TIP_WIDTH_MM * f),
-         "flank_angle_deg": 20, "hub_width_mm": _r(CCS_HUB_MM * f)}
+         "flank_angle_deg": 20, "hub_width_mm": _r(CCS_HUB_MM * f), "shell_coverage": "near_rock"}
     if scale == "full":
         c.update(tip_radius_mm=1.0, shell_radius_mm=0.25)
     else:

@@ -209,6 +209,15 @@ class Cutter(_Model):
         0.3, "mm", "LAMMPS: radius of the spheres that represent the cutter surface.", gt=0
     )
     shell_spacing: float = _f(1.0, "1", "LAMMPS: centre spacing of shell spheres, in shell diameters.", gt=0.3, le=1.5)
+    shell_coverage: Literal["full", "near_rock"] = _f(
+        "full", "token", "LAMMPS: 'full' covers the whole cutter with shell spheres; 'near_rock' keeps only the spheres "
+        "that come within shell_margin_mm of the block's bounding box at some time of the planned motion (the same "
+        "contacts for grains of the block, far fewer spheres on large discs).",
+    )
+    shell_margin_mm: float | None = _f(
+        None, "mm", "LAMMPS, shell_coverage near_rock: distance from the block within which shell spheres are kept "
+        "(default: 3 largest grain diameters, room for chips lifted off the surface).", gt=0,
+    )
     wear_flat_mm: float = _f(
         0.0, "mm", "Width of a worn, flat land at the rim: the profile is cut off at the radius where it is this wide "
         "(0 = sharp, as built; discrepancy effect 'wear_flat').", ge=0,

@@ -5,7 +5,8 @@
     python -m deckgen.families check [--root DIR]   exit 1 if a committed file differs from the generator
     python -m deckgen.families list                 one line per case: family, scale, name, estimates
     python -m deckgen.families report --family F --index cases/F/index.csv --out DIR PARSED...
-                                                    family table (factors, grains, wall time, forces) + plots
+                                                    family table (factors, grains, wall time, forces), plots
+                                                    and trends.csv (the seeds' trends fitted on the runs)
 
 Each family has a **full-scale** set (the seed's geometry and speeds, for clusters) and a
 **reduced-scale** set that runs on 2 cores in minutes per case. Every case file starts with a header
@@ -601,14 +602,136 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
     for d in map(Path, parsed_dirs):
         s = json.loads((d / "summary.json").read_text())
         row = {k: s.get(k, float("nan")) for k in TABLE_FIELDS}
+        spec_json = d.parent / "run" / "spec.json"  # the run folder beside parsed/ (deckgen's layout)
+        derived = json.loads(spec_json.read_text()).get("derived", {}) if spec_json.is_file() else {}
+        row["n_shell"] = derived.get("n_shell", float("nan"))
+        try:
+            row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)
+        except (KeyError, TypeError, ValueError):
+            row["cycles_in_window_1"] = float("nan")
         fn, fs = row["force_normal_N_peak"], row["force_side_N_peak"]
         try:
             row["lateral_to_normal_ratio_1"] = abs(float(fs)) / abs(float(fn))
         except (TypeError, ValueError, ZeroDivisionError):
             row["lateral_to_normal_ratio_1"] = float("nan")
         rows.append({"case": s["case"], **row})
-    runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "lateral_to_normal_ratio_1"])
+    runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1"])
+    runs = runs.drop(columns=[c for c in runs.columns if c in idx.columns and c != "case"])  # the index's factor wins
     return idx.merge(runs, on="case", how="inner")
+
+
+@dataclass(frozen=True)
+class Trend:
+    """A trend the seed reports, tested on a family's runs: y against x within groups of fixed factors.
+
+    ``expect`` is the sign the seed reports (+1 rises, -1 falls); ``seed_change`` the seed's relative
+    change of y over its x range (with ``seed_note`` saying where it comes from)."""
+
+    id: str
+    text: str
+    y: str
+    x: str
+    groups: tuple[str, ...]
+    expect: int
+    seed_change: float
+    seed_note: str
+    log_x: bool = False
+    abs_y: bool = False
+    only: str = ""  # pandas query selecting the runs the trend is about ("" = all)
+
+
+#: the trends of issue #4 with the sizes the seeds report (relative change of y from the smallest to the largest x)
+TRENDS: dict[str, tuple[Trend, ...]] = {
+    "indentation_asymmetric": (
+        Trend("fn_rises_with_t", "maximum normal force rises with the cut spacing t", "force_normal_N_peak",
+              "cut_spacing_mm", ("rock", "disc_diameter_mm"), +1, 1.0,
+              "seed 000 sec. 3.3 (Fig. 16 text): 'increasing the cut spacing from 15 to 25 mm causes an almost "
+              "twofold increase in the pressing force' (taken as +100 %)"),
+        Trend("fn_rises_with_d", "maximum normal force rises with the disc diameter D", "force_normal_N_peak",
+              "disc_diameter_mm", ("rock", "cut_spacing_mm"), +1, 0.15,
+              "seed 000 sec. 3.3: D 150 -> 160 mm raises the pressing force by about 15 %"),
+    ),
+    "linear_ccs": (
+        Trend("fn_rises_with_s", "mean normal force rises with the spacing S", "force_normal_N_mean_steady",
+              "spacing_mm", ("penetration_mm",), +1, 193.8 / 122.4 - 1,
+              "seed 001 Tables 3-4, LS-DYNA at p 6.4 mm: 122.4 kN at S 25 mm -> 193.8 kN at S 100 mm"),
+        Trend("fr_fn_rises_with_p", "Fr/Fn rises with the penetration p", "rolling_to_normal_ratio_1",
+              "penetration_mm", ("spacing_mm",), +1, (31.7 / 208.6) / (9.3 / 118.4) - 1,
+              "seed 001 Table 4, LS-DYNA at S 100 mm: Fr/Fn 9.3/118.4 at p 1.9 mm -> 31.7/208.6 at p 7.6 mm"),
+    ),
+    "rotary": (
+        Trend("fs_falls_with_r", "side force falls with the path radius r", "force_side_N_mean_steady",
+              "rotary_radius_mm", (), -1, 8.1 / 19.9 - 1,
+              "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: side force 19.9 kN at r 250 mm -> 8.1 kN at r 1000 mm",
+              log_x=True, abs_y=True),
+        Trend("fr_fn_falls_with_r", "Fr/Fn falls with the path radius r", "rolling_to_normal_ratio_1",
+              "rotary_radius_mm", (), -1, (16.1 / 143.1) / (22.3 / 105.0) - 1,
+              "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: Fr/Fn 22.3/105.0 at r 250 -> 16.1/143.1 at r 1000 mm",
+              log_x=True),
+    ),
+    "odc": (
+        Trend("f_falls_with_freq_nu_lt_1", "mean force falls with the oscillation frequency when nu < 1",
+              "force_magnitude_N_mean_steady", "frequency_hz", ("eccentricity_ratio_1", "speed_m_s"), -1,
+              442.3 / 636.0 - 1,
+              "seed 003 Table 5.1, e/R 0.4, 0.5 m/s: 636 N at 22.5 rev/s -> 442.3 N at 67.5 rev/s (the thesis "
+              "states -38 %)", only="velocity_ratio_nu_1 < 1 and frequency_hz > 0"),
+        Trend("f_falls_with_freq_nu_lt_1_half_cycle", "the same, only runs whose steady window holds at least half an "
+              "oscillation cycle (a mean over a fraction of a cycle depends on the phase)",
+              "force_magnitude_N_mean_steady", "frequency_hz", ("eccentricity_ratio_1", "speed_m_s"), -1,
+              442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)",
+              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
+    ),
+}
+
+
+def trend_table(family: str, table: "Any") -> "Any":
+    """Each trend of ``family`` fitted on the runs: pooled OLS y ~ x + group effects (statsmodels).
+
+    Columns: runs and groups used, pooled slope and its p-value, the mean relative change of y over
+    the x range within groups (fitted line), the seed's, and whether the sign is the seed's."""
+    import numpy as np
+    import pandas as pd
+    import statsmodels.formula.api as smf
+
+    rows = []
+    for tr in TRENDS.get(family, ()):
+        t = table.copy()
+        for c in t.columns:  # numeric columns as numbers (index.csv writes 'inf' for nu without oscillation)
+            num = pd.to_numeric(t[c], errors="coerce")
+            if num.notna().sum() == t[c].replace("", np.nan).notna().sum():
+                t[c] = num
+        if tr.only:
+            t = t.query(tr.only)
+        t = t.dropna(subset=[tr.x, tr.y])
+        t = t.assign(_x=np.log(t[tr.x]) if tr.log_x else t[tr.x], _y=t[tr.y].abs() if tr.abs_y else t[tr.y])
+        t["_g"] = t[list(tr.groups)].astype(str).agg("|".join, axis=1) if tr.groups else "all"
+        usable = t.groupby("_g")["_x"].transform("nunique") >= 2
+        t = t[usable]
+        row = {"family": family, "trend": tr.id, "description": tr.text, "y": tr.y, "x": tr.x + (" (log)" if tr.log_x else ""),
+               "runs": int(len(t)), "groups": int(t["_g"].nunique()), "expected_sign": tr.expect,
+               "seed_change_1": tr.seed_change, "seed_source": tr.seed_note}
+        if len(t) < 2:
+            rows.append({**row, "slope": float("nan"), "p_value": float("nan"), "change_1": float("nan"),
+                         "sign_as_seed": None, "significant_5pct": None})
+            continue
+        changes = []
+        for _, g in t.groupby("_g"):
+            b, a = np.polyfit(g["_x"], g["_y"], 1)
+            y0, y1 = a + b * g["_x"].min(), a + b * g["_x"].max()
+            changes.append((y1 - y0) / abs(y0) if y0 != 0 else float("nan"))
+        formula = "_y ~ _x" + (" + C(_g)" if t["_g"].nunique() > 1 else "")
+        dof = len(t) - (1 + t["_g"].nunique())
+        if dof >= 1:
+            fit = smf.ols(formula, data=t).fit()
+            slope, pval = float(fit.params["_x"]), float(fit.pvalues["_x"])
+        else:  # as many parameters as runs: the slope is exact, no p-value
+            slope, pval = float(np.mean([np.polyfit(g["_x"], g["_y"], 1)[0] for _, g in t.groupby("_g")])), float("nan")
+        rows.append({**row, "slope": slope, "p_value": pval, "change_1": float(np.nanmean(changes)),
+                     "sign_as_seed": bool(np.sign(slope) == tr.expect),
+                     "significant_5pct": (bool(pval < 0.05) if pval == pval else None)})
+    cols = ["family", "trend", "description", "y", "x", "runs", "groups", "slope", "p_value", "change_1", "seed_change_1",
+            "sign_as_seed", "significant_5pct", "expected_sign", "seed_source"]
+    return pd.DataFrame(rows, columns=cols)
 
 
 def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
@@ -652,6 +775,7 @@ def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], ou
     path = out / "family_table.csv"
     table.to_csv(path, index=False)
     family_plots(family, table, out / "plots")
+    trend_table(family, table).to_csv(out / "trends.csv", index=False)
     return path
 
 

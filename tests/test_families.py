@@ -277,3 +277,18 @@ def test_odc_trend_keeps_only_nu_below_one_and_half_a_cycle():
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "runs"] == 3
     assert bool(t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "sign_as_seed"])
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "change_1"] < -0.4
+
+
+def test_family_regression_recovers_seed001_form_on_runs():
+    """Y = 50 + 4 S + 30 p exactly: the family regression returns those coefficients and R^2 = 1."""
+    tab = _linear_table(lambda S: 0.0, lambda p: 0.1)
+    tab["force_normal_N_mean_steady"] = 50 + 4 * tab["spacing_mm"] + 30 * tab["penetration_mm"]
+    tab["force_rolling_N_mean_steady"] = 2 + 0.5 * tab["penetration_mm"] + 0.01 * tab["spacing_mm"] ** 2
+    r = fam.family_regression("linear_ccs", tab)
+    fn = r[r["response"] == "force_normal_N_mean_steady"].set_index("term")
+    assert fn.loc["const", "estimate"] == pytest.approx(50) and fn.loc["spacing_mm", "estimate"] == pytest.approx(4)
+    assert fn.loc["penetration_mm", "estimate"] == pytest.approx(30) and fn["r_squared"].iloc[0] == pytest.approx(1.0)
+    assert fn.loc["spacing_mm", "vif"] == pytest.approx(1.0)  # full factorial: S and p uncorrelated
+    fr = r[r["response"] == "force_rolling_N_mean_steady"]
+    assert 0.5 < fr["r_squared"].iloc[0] < 1.0  # the S^2 term is not in the linear form
+    assert fam.family_regression("rotary", tab).empty

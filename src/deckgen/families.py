@@ -6,7 +6,8 @@
     python -m deckgen.families list                 one line per case: family, scale, name, estimates
     python -m deckgen.families report --family F --index cases/F/index.csv --out DIR PARSED...
                                                     family table (factors, grains, wall time, forces), plots
-                                                    and trends.csv (the seeds' trends fitted on the runs)
+                                                    trends.csv (the seeds' trends fitted on the runs) and,
+                                                    for linear_ccs, regression.csv (seed 001 eq. 7 on the runs)
 
 Each family has a **full-scale** set (the seed's geometry and speeds, for clusters) and a
 **reduced-scale** set that runs on 2 cores in minutes per case. Every case file starts with a header
@@ -734,6 +735,29 @@ def trend_table(family: str, table: "Any") -> "Any":
     return pd.DataFrame(rows, columns=cols)
 
 
+def family_regression(family: str, table: "Any") -> "Any":
+    """linear_ccs: seed 001 eq. 7 (Y = b0 + b1 S + b2 p, OLS with p-values, 95 % CI, VIF and R^2) fitted on the
+    runs' mean normal and rolling forces (N, S and p in mm); empty for other families or too few runs."""
+    import pandas as pd
+
+    from deckgen.analysis.regression import fit_linear_spacing_penetration
+
+    cols = ["response", "term", "estimate", "std_error", "p_value", "ci95_low", "ci95_high", "vif", "r_squared", "n_runs"]
+    if family != "linear_ccs":
+        return pd.DataFrame(columns=cols)
+    t = table.copy()
+    rows = []
+    for resp in ("force_normal_N_mean_steady", "force_rolling_N_mean_steady"):
+        d = t[["spacing_mm", "penetration_mm", resp]].apply(pd.to_numeric, errors="coerce").dropna()
+        if len(d) < 4 or d["spacing_mm"].nunique() < 2 or d["penetration_mm"].nunique() < 2:
+            continue
+        fit = fit_linear_spacing_penetration(d, resp)
+        for term, c in fit.coefficients.iterrows():
+            rows.append({"response": resp, "term": term, **{k: float(c[k]) for k in cols[2:8]},
+                         "r_squared": fit.r_squared, "n_runs": fit.n_obs})
+    return pd.DataFrame(rows, columns=cols)
+
+
 def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
     """Force (and ratio) vs the family's main factor, one line per group; PNGs into ``out``."""
     import pandas as pd
@@ -776,6 +800,9 @@ def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], ou
     table.to_csv(path, index=False)
     family_plots(family, table, out / "plots")
     trend_table(family, table).to_csv(out / "trends.csv", index=False)
+    reg = family_regression(family, table)
+    if len(reg):
+        reg.to_csv(out / "regression.csv", index=False)
     return path
 
 

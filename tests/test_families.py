@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from deckgen import families as fam
 from deckgen.deck import cutter_path
@@ -138,7 +139,29 @@ def test_reduced_scale_headers_state_the_scaling():
             head = _header(path)
             for text in must:
                 assert text in " ".join(head.replace("#", " ").split()), (path, text)
-            assert "placeholder" in head
+            assert ("placeholder" in head) != ("calibrated card" in head)
+
+
+def test_family_bonds_keep_the_rocks_failure_strain_when_softened():
+    """Softening divides moduli and strengths alike: sigma_c/E_b (the bond failure strain) is the unsoftened one."""
+    b, c, lines = fam.rock_micro("colorado_red_granite")
+    # placeholder: smoke rock (E_b 40 GPa, sigma 30 MPa -> UCS 19.7 MPa, E 12 GPa) scaled to E 41 GPa, UCS 158 MPa
+    assert b["youngs_modulus_GPa"] == pytest.approx(40 * 41 / 12, rel=1e-3)
+    assert b["tensile_strength_MPa"] == pytest.approx(30 * 158 / 19.7, rel=1e-3)
+    assert b["shear_strength_MPa"] == pytest.approx(2 * b["tensile_strength_MPa"], rel=1e-3)
+    bs, cs, ls = fam.rock_micro("colorado_red_granite", soften_to_GPa=10)
+    assert bs["youngs_modulus_GPa"] == 10 and cs["youngs_modulus_GPa"] == pytest.approx(10)
+    assert bs["tensile_strength_MPa"] / 10 == pytest.approx(b["tensile_strength_MPa"] / b["youngs_modulus_GPa"], rel=1e-3)
+    assert "forces are 1/13.667" in " ".join(ls)
+    # a converged card is used as calibrated (limestone: E_b 58.2 GPa, sigma = tau 42.7 MPa, g ~ 0)
+    card = yaml.safe_load((ROOT / "cases/materials/savonniere_limestone.yaml").read_text())["calibrated"]
+    bl, cl, ll = fam.rock_micro("savonniere_limestone", soften_to_GPa=10)
+    F = card["bonds"]["youngs_modulus_GPa"] / 10
+    assert bl["tensile_strength_MPa"] == pytest.approx(card["bonds"]["tensile_strength_MPa"] / F, rel=1e-3)
+    assert bl["gap_tolerance"] == card["bonds"]["gap_tolerance"] and cl["friction"] == card["contact"]["friction"]
+    assert "calibrated card" in " ".join(ll)
+    # cards that did not converge are not used
+    assert fam.calibrated_card("sandstone") is None
 
 
 def test_reduced_scale_numbers_follow_the_stated_factors():

@@ -53,6 +53,9 @@ SCALES = ("full", "reduced")
 #: Placeholder bond strengths scale it to a rock's UCS: sigma_c = 30 MPa * UCS / 19.7 MPa (tau_c = 2 sigma_c).
 SMOKE_UCS_MPA = 19.7
 SMOKE_SIGMA_MPA = 30.0
+#: ... with E_b = E_c = 40 GPa it has E = 12.0 GPa (README smoke table): a placeholder scales the moduli by E/12 GPa
+SMOKE_E_GPA = 12.0
+SMOKE_E_B_GPA = 40.0
 
 #: Rock targets (cases/materials/<rock>.yaml; data/rocks.csv): density kg/m3, UCS MPa, E GPa.
 ROCKS: dict[str, dict[str, float]] = {
@@ -83,10 +86,58 @@ def _tag(x: float) -> str:
     return str(v).replace(".", "p").replace("-", "m")
 
 
-def placeholder_bonds(rock: str, youngs_modulus_GPa: float) -> dict[str, Any]:
-    """Bond placeholder until results/calibration/<rock>/card.yaml exists (see the module doc)."""
-    s = _r(SMOKE_SIGMA_MPA * ROCKS[rock]["ucs_MPa"] / SMOKE_UCS_MPA, 0)
-    return {"youngs_modulus_GPa": youngs_modulus_GPa, "tensile_strength_MPa": s, "shear_strength_MPa": 2 * s}
+def calibrated_card(rock: str) -> dict[str, Any] | None:
+    """The ``calibrated`` block of cases/materials/<rock>.yaml when its calibration converged, else None."""
+    from deckgen.render import repo_root
+
+    path = repo_root() / "cases" / "materials" / f"{rock}.yaml"
+    if not path.is_file():
+        return None
+    card = yaml.safe_load(path.read_text())
+    if not (card.get("provenance") or {}).get("converged") or not card.get("calibrated"):
+        return None
+    return card["calibrated"]
+
+
+def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str, Any], dict[str, Any], list[str]]:
+    """Bond and contact blocks of a family case for ``rock``, and the header lines that say where they come from.
+
+    A converged card (cases/materials/<rock>.yaml, issue #3) gives the micro-parameters. Otherwise a
+    placeholder scales the smoke UCS rock (E_b = E_c 40 GPa, sigma_c 30, tau_c 60 MPa -> UCS 19.7 MPa,
+    E 12.0 GPa) to the rock: moduli x E/12 GPa, strengths x UCS/19.7 MPa, so the bond failure strain
+    sigma_c/E_b follows the rock's UCS/E. With ``soften_to_GPa`` moduli AND strengths are divided by
+    F = E_b/soften (when F > 1): the time step grows by sqrt(F), failure strains (brittleness) and all
+    force ratios stay, forces are 1/F of the rock's.
+    """
+    card = calibrated_card(rock)
+    if card:
+        b = {k: float(v) for k, v in card["bonds"].items()}
+        c = {k: float(v) for k, v in (card.get("contact") or {}).items()}
+        c.setdefault("youngs_modulus_GPa", b["youngs_modulus_GPa"])
+        source = f"calibrated card cases/materials/{rock}.yaml (issue #3; calibrated at its own grain size)"
+    else:
+        k_e = ROCKS[rock]["youngs_modulus_GPa"] / SMOKE_E_GPA
+        k_s = ROCKS[rock]["ucs_MPa"] / SMOKE_UCS_MPA
+        b = {"youngs_modulus_GPa": SMOKE_E_B_GPA * k_e, "tensile_strength_MPa": SMOKE_SIGMA_MPA * k_s,
+             "shear_strength_MPa": 2 * SMOKE_SIGMA_MPA * k_s}
+        c = {"youngs_modulus_GPa": SMOKE_E_B_GPA * k_e}
+        source = (f"placeholder (no converged card): the smoke rock scaled to E {ROCKS[rock]['youngs_modulus_GPa']} GPa and "
+                  f"UCS {ROCKS[rock]['ucs_MPa']} MPa (moduli x{_r(k_e, 3)}, strengths x{_r(k_s, 3)})")
+    F = 1.0
+    if soften_to_GPa is not None and b["youngs_modulus_GPa"] > soften_to_GPa:
+        F = b["youngs_modulus_GPa"] / soften_to_GPa
+        for key in ("youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa"):
+            b[key] = b[key] / F
+        c["youngs_modulus_GPa"] = c["youngs_modulus_GPa"] / F
+    b = {k: _r(v, 4) for k, v in b.items()}
+    c = {k: _r(v, 4) for k, v in c.items()}
+    text = (f"Bonds: {source}: E_b {b['youngs_modulus_GPa']} GPa, sigma_c {b['tensile_strength_MPa']} MPa, tau_c "
+            f"{b['shear_strength_MPa']} MPa, contact E {c['youngs_modulus_GPa']} GPa"
+            + (f"; softened: moduli and strengths / {_r(F, 3)} (failure strains kept, dt x{_r(math.sqrt(F), 2)}; forces are "
+               f"1/{_r(F, 3)} of the rock's)." if F > 1 else "."))
+    import textwrap
+
+    return b, c, textwrap.wrap(text, 110)
 
 
 def half_chord_mm(radius_mm: float, penetration_mm: float) -> float:
@@ -287,7 +338,7 @@ def linear_ccs() -> list[CaseDef]:
                 travel = middle_travel(L, R, p, clear)
                 name = f"lin_full_s{S_full}_p{_tag(p)}"
                 packing = {"radius_min_mm": 0.5, "radius_max_mm": 0.75}
-                bonds = placeholder_bonds(rock, 40)
+                bonds, contact, bond_lines = rock_micro(rock)
                 kin = {"mode": "linear", "speed_m_s": 0.33, "penetration_mm": p, "travel_mm": travel,
                        "start_clearance_mm": clear, "spin": "rolling", "neighbour_spacing_mm": S}
                 outputs = {"series_every": 2000, "bond_state_every": 200000,
@@ -302,8 +353,8 @@ def linear_ccs() -> list[CaseDef]:
                     "(kinematics.neighbour_spacing_mm; seed 001's three discs cut at once, this is the relieved state).",
                     "Steady window: contact patch in the middle 40-60 % of the rock (seed 001: 400-600 ms), clipped to",
                     "the travel, which ends there. Grains r 0.5-0.75 mm: p = 1.9 mm is only 1.5 grain diameters (seed 001 used 0.3 mm SPG",
-                    "particles; a DEM at that size is ~30x more grains). Bonds: placeholder (E_b 40 GPa, strengths",
-                    "scaled from the smoke UCS to 158 MPa); use results/calibration/colorado_red_granite/card.yaml.",
+                    "particles; a DEM at that size is ~30x more grains).",
+                    *bond_lines,
                 ]
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
@@ -314,7 +365,7 @@ def linear_ccs() -> list[CaseDef]:
                 travel = middle_travel(L, R, p, clear)
                 name = f"lin_red_s{S_full}_p{_tag(p_full)}"
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
-                bonds = placeholder_bonds(rock, 10)
+                bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
                 kin = {"mode": "linear", "speed_m_s": 2.0, "penetration_mm": p, "travel_mm": travel,
                        "start_clearance_mm": clear, "spin": "rolling", "neighbour_spacing_mm": S}
                 outputs = {"series_every": 100, "bond_state_every": 5000,
@@ -326,12 +377,12 @@ def linear_ccs() -> list[CaseDef]:
                     "because grains are not scaled (r 0.7-1.0 mm; 1/8 would put p below one grain), so p/R is 4x the",
                     f"seed's (contact angle ~2x). Block 26 x {W} x 12 mm (not 304/8 = 38 mm long), {travel} mm of travel; steady",
                     "window as full scale (contact patch in the middle 40-60 % of the block). 2 m/s (6x the seed's 0.33)",
-                    "with rolling spin, for ~1e5 steps. Bonds softened to E_b 10 GPa (dt x2; placeholder strengths",
-                    "scaled from the smoke UCS to CRG's 158 MPa) until results/calibration/colorado_red_granite/card.yaml",
-                    f"exists. Neighbour grooves at +-S = {S} mm (S x 1/8, only {_r(S / 1.7, 1)} grain diameters) cut out before the cut.",
+                    "with rolling spin, for ~1e5 steps.",
+                    f"Neighbour grooves at +-S = {S} mm (S x 1/8, only {_r(S / 1.7, 1)} grain diameters) cut out before the cut.",
                     "Forces scale ~ length^2; Fr/Fn vs p and F_n vs S are the trends to compare.",
+                    *bond_lines,
                 ]
-            contact = {"youngs_modulus_GPa": ROCKS[rock]["youngs_modulus_GPa"], "cutter_friction": 0.3}
+            contact = {**contact, "cutter_friction": 0.3}
             block = {"length_mm": L, "width_mm": W, "height_mm": H, "fixed_faces": ["zmin", "xmax"]}
             data = _cutting(name, rock, packing, bonds, contact, block, _ccs_cutter(f, scale), kin, outputs)
             if scale == "full":
@@ -360,7 +411,7 @@ def rotary() -> list[CaseDef]:
                 travel = middle_travel(L, R, p, clear)
                 name = f"rot_full_r{r_full}"
                 packing = {"radius_min_mm": 0.5, "radius_max_mm": 0.75}
-                bonds = placeholder_bonds(rock, 40)
+                bonds, contact, bond_lines = rock_micro(rock)
                 kin_speed = 0.33
                 outputs = {"series_every": 2000, "bond_state_every": 200000,
                            "steady_window": middle_window(L, R, p, clear, travel)}
@@ -372,7 +423,8 @@ def rotary() -> list[CaseDef]:
                     "0.33 m/s with rolling spin as seed 001 (seed 002 gives none). Block 240 x 220 x 60 mm (seed 002",
                     f"Fig. 2 not transcribed): wide enough for the {travel} mm arc at r = 250 mm; travel and steady window",
                     "as linear_ccs (contact patch in the middle 40-60 % of the block length). Grains r 0.5-0.75 mm;",
-                    "placeholder bonds (as linear_ccs full). Single disc (no neighbour grooves).",
+                    "single disc (no neighbour grooves).",
+                    *bond_lines,
                 ]
             else:
                 f, fp, R = REDUCED_DISC, REDUCED_PEN, CCS_D_MM * REDUCED_DISC / 2
@@ -382,7 +434,7 @@ def rotary() -> list[CaseDef]:
                 travel = middle_travel(L, R, p, clear)
                 name = f"rot_red_r{r_full}"
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
-                bonds = placeholder_bonds(rock, 10)
+                bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
                 kin_speed = 2.0
                 outputs = {"series_every": 100, "bond_state_every": 5000,
                            "steady_window": middle_window(L, R, p, clear, travel)}
@@ -392,10 +444,10 @@ def rotary() -> list[CaseDef]:
                     f"{_r(CCS_TIP_WIDTH_MM * f)} mm, r = {r} mm, so the path curvature relative to the disc (R/r) is the seed's.",
                     f"Penetration factor 1/2 (grains r 0.7-1.0 mm are not scaled): p = {p} mm (6.4). Block 26 x 42 x 10 mm",
                     f"(wide for the arc drift), {travel} mm of travel, window as linear_ccs. 2 m/s (6x seed 001's 0.33 m/s) with",
-                    "rolling spin; bonds softened to E_b 10 GPa (dt x2), placeholder strengths scaled to UCS 158 MPa.",
-                    "Side force and Fr/Fn vs r are the trends to compare; forces scale ~ length^2 (docs/families.md).",
+                    "rolling spin. Side force and Fr/Fn vs r are the trends to compare; forces scale ~ length^2 (docs/families.md).",
+                    *bond_lines,
                 ]
-            contact = {"youngs_modulus_GPa": ROCKS[rock]["youngs_modulus_GPa"], "cutter_friction": 0.3}
+            contact = {**contact, "cutter_friction": 0.3}
             block = {"length_mm": L, "width_mm": W, "height_mm": H, "fixed_faces": ["zmin", "xmax"]}
             kin = {"mode": "rotary", "speed_m_s": kin_speed, "penetration_mm": p, "travel_mm": travel,
                    "start_clearance_mm": clear, "rotary_radius_mm": r, "spin": "rolling"}
@@ -440,7 +492,7 @@ def odc() -> list[CaseDef]:
                 L, W, H = 70, 70, 20
                 kin.update(travel_mm=40, start_clearance_mm=1)
                 packing = {"radius_min_mm": 0.65, "radius_max_mm": 0.95}
-                bonds = placeholder_bonds(rock, 40)
+                bonds, contact, bond_lines = rock_micro(rock)
                 outputs = {"series_every": 1000, "bond_state_every": 200000}
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, FULL SCALE (for clusters): Table 5.1 sim {sim}.",
@@ -449,15 +501,15 @@ def odc() -> list[CaseDef]:
                     + (f", nu = V/(e w) = {nu:.2f}." if osc else " (no oscillation)."),
                     "The disc turns with the eccentric shaft (spin shaft), as in the thesis. Grains r 0.65-0.95 mm: ~32k",
                     "in the block as sec. 5.2 (32k particles at porosity 0.25). 40 mm of travel (not given in the thesis).",
-                    "Bonds: placeholder (E_b 40 GPa, strengths scaled from the smoke UCS to 16.5 MPa); the thesis used its",
-                    "BTS-calibrated set; use results/calibration/savonniere_limestone/card.yaml when it exists.",
+                    "The thesis used its own BTS-calibrated bond set.",
+                    *bond_lines,
                 ]
             else:
                 travel = 12 if V >= 0.5 else 6
                 L, W, H = travel + 14, 24, 10
                 kin.update(travel_mm=travel, start_clearance_mm=0.3)
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
-                bonds = placeholder_bonds(rock, 10)
+                bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
                 outputs = {"series_every": 100, "bond_state_every": 5000}
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): Table 5.1 sim {sim}.",
@@ -467,10 +519,10 @@ def odc() -> list[CaseDef]:
                     + (f" = {nu:.2f} and" if osc else " and"),
                     "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress",
                     "rho*c*v 4x) and only " + (f"{travel * freq / (speed * 1e3):.2f} cycles" if osc else "a linear cut")
-                    + " fit in the travel. Bonds softened to E_b 10 GPa (dt x2),",
-                    "placeholder strengths scaled to UCS 16.5 MPa, until results/calibration/savonniere_limestone/card.yaml.",
+                    + " fit in the travel.",
+                    *bond_lines,
                 ]
-            contact = {"youngs_modulus_GPa": ROCKS[rock]["youngs_modulus_GPa"], "cutter_friction": 0.3}
+            contact = {**contact, "cutter_friction": 0.3}
             block = {"length_mm": L, "width_mm": W, "height_mm": H, "fixed_faces": ["zmin", "xmax"]}
             cutter = {"kind": "cone_disc", "diameter_mm": 20, "small_diameter_mm": 10, "clearance_angle_deg": clr,
                       "rake_angle_deg": 30, "tip_radius_mm": 0, "shell_radius_mm": 0.3}

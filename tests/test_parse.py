@@ -555,3 +555,39 @@ def test_series_without_title(tmp_path):
     title_only = tmp_path / "title.txt"
     title_only.write_text("# step fx\n")
     assert list(read_series(title_only).columns) == ["step", "fx"]
+
+
+def test_grains_inside_cutter_follows_the_cutter_path():
+    """The leak check puts the cutter body where the deck moved it: linear (tiny_cut golden) and rotary (tiny_rotary)."""
+    import json
+    import math
+
+    import numpy as np
+
+    from deckgen.results import grains_inside_cutter
+
+    golden = Path(__file__).resolve().parent / "data" / "golden"
+    spec = json.loads((golden / "tiny_cut" / "spec.json").read_text())
+    cut = spec["derived"]["cutter"]
+    R, t = cut["radius"], cut["duration"]
+    xc = cut["xc0"] + cut["V"] * t + cut["ecc"] * (math.cos(cut["omega"] * t) - 1)
+    zc = cut["zc0"] + cut["ecc"] * math.sin(cut["omega"] * t)
+    pts = np.array([[xc, cut["yc0"], zc - 0.8 * R],      # inside, below the centre
+                    [xc, cut["yc0"], zc - 1.1 * R],      # below the rim: outside
+                    [cut["xc0"] - 0.9 * R, cut["yc0"], cut["zc0"]],  # behind the start centre: outside by now
+                    [xc, cut["yc0"] + 3e-3, zc - 0.5 * R]])  # beside the disc (hub 4 mm wide): outside
+    assert grains_inside_cutter(pts, spec, t) == 1
+    # at t = 0 the third point is inside and the first still is (2.7 mm of travel: 5.5 mm from the start centre < R)
+    assert grains_inside_cutter(pts, spec, 0.0) == 2
+    assert grains_inside_cutter(pts[[2]], spec, 0.0) == 1 and grains_inside_cutter(pts[[2]], spec, t) == 0
+    rot = json.loads((golden / "tiny_rotary" / "spec.json").read_text())
+    c = rot["derived"]["cutter"]
+    t = c["duration"]
+    phi = c["yaw_rate"] * t
+    centre = np.array([c["axis_x"] + c["rotary_radius"] * math.sin(phi), c["axis_y"] - c["rotary_radius"] * math.cos(phi), c["zc0"]])
+    ahead = np.array([math.cos(phi), math.sin(phi), 0.0])  # the path tangent: in the disc plane
+    side = np.array([-math.sin(phi), math.cos(phi), 0.0])  # the yawed axis
+    R = c["radius"]
+    pts = np.array([centre + 0.8 * R * ahead, centre + 0.8 * R * side, centre - [0, 0, 0.8 * R]])
+    assert grains_inside_cutter(pts, rot, t) == 2  # in the disc plane yes, along the axis no
+    assert phi > 0.05  # the yaw is large enough for the test to tell the axes apart

@@ -151,7 +151,7 @@ CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "contact_fraction_steady_1", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "kinematics_mode", "cut_duration_s", "steady_start_s", "steady_end_s", "steady_rows",
     "cutter_radius_m", "cutter_speed_m_s", "eccentricity_m", "omega_rad_s", "travel_m",
-    "penetration_m",
+    "penetration_m", "grains_inside_cutter_final",
 ]
 DAMAGE_SUMMARY_COLUMNS = [
     "case", "engine", "test", "n_grains", "n_grains_bonded", "n_grains_missing_final",
@@ -534,6 +534,7 @@ def _damage(run_dir: Path, state: _RunState) -> tuple[pd.DataFrame, dict[str, An
     dmg = dmg.sort_values("id", kind="stable").reset_index(drop=True)
     if missing:
         state.notes.append(f"{missing} grain(s) missing from the final frame (lost atoms): damage NaN")
+    info["final_xyz_m"] = d1[["x", "y", "z"]].to_numpy(dtype=float)
     info.update({
         "damage_source": source, "damage_step": int(last.timestep), "n_grains_missing_final": missing,
         # (sum c_nb initial - sum c_nb final) / 2 over rock grains present in both frames
@@ -583,6 +584,48 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         "final_strain_1": float(strain[-1]),
     })
     return out
+
+
+def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int | None:
+    """Rock grains whose centres lie inside the true cutter body at time ``t`` (a leak through the shell).
+
+    A grain touching the shell from outside keeps its centre at least its radius outside the true
+    surface (the shell spheres sit their own radius inside it), so a centre inside the body means the
+    grain got through a gap of the shell or through a part ``shell_coverage: near_rock`` left out.
+    The cutter body is the axisymmetric profile about its (yawing) axis; None where that does not
+    hold (tilted axis, cone disc with clearance) or the geometry cannot be rebuilt.
+    """
+    from types import SimpleNamespace
+
+    from matplotlib.path import Path as MplPath
+
+    from deckgen.deck import cutter_params
+    from deckgen.geometry import _coerce_params, wear_flat
+    from deckgen.spec import MM, Cutter
+
+    case, cut = spec["case"], spec["derived"].get("cutter") or {}
+    try:
+        cutter = Cutter.model_validate(case["cutter"])
+    except Exception:  # a spec.json of another version: no check rather than a wrong one
+        return None
+    if cutter.tilt_deg or (cutter.kind == "cone_disc" and cutter.clearance_angle_deg) or not cut:
+        return None
+    kind, prm = cutter_params(SimpleNamespace(cutter=cutter))
+    prof = wear_flat(_coerce_params(kind, prm).profile(), cutter.wear_flat_mm * MM)
+    if cut.get("rotary_radius"):
+        phi = cut["yaw_rate"] * t
+        centre = np.array([cut["axis_x"] + cut["rotary_radius"] * math.sin(phi),
+                           cut["axis_y"] - cut["rotary_radius"] * math.cos(phi), cut["zc0"]])
+        axis = np.array([-math.sin(phi), math.cos(phi), 0.0])
+    else:
+        ind, e, w, V = cut["mode_indent"], cut["ecc"], cut["omega"], cut["V"]
+        centre = np.array([cut["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0)), cut["yc0"],
+                           cut["zc0"] - ind * V * t + (1 - ind) * e * math.sin(w * t)])
+        axis = np.array([0.0, 1.0, 0.0])
+    d = np.asarray(xyz, float) - centre
+    a = d @ axis
+    rho = np.linalg.norm(d - np.outer(a, axis), axis=1)
+    return int(MplPath(prof).contains_points(np.column_stack([rho, a])).sum())
 
 
 def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
@@ -728,6 +771,13 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
         if note:
             state.notes.append(note)
         summary.update(extra)
+        xyz = dinfo.get("final_xyz_m")
+        inside = (grains_inside_cutter(xyz, spec, int(dinfo["damage_step"]) * dt)
+                  if xyz is not None and dinfo["damage_source"] == "final.dump.gz" else None)
+        summary["grains_inside_cutter_final"] = inside if inside is not None else _nan()
+        if inside:
+            state.notes.append(f"{inside} grain centre(s) inside the cutter body at the end: grains leaked through the "
+                               "cutter shell (denser shell_spacing, larger shell margin or weaker forces)")
         from deckgen.chips import analyse, initial_bonds
 
         if derived.get("n_bonds", 0) and initial_bonds(run_dir) is not None:

@@ -640,7 +640,7 @@ TABLE_FIELDS = [
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
     "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
-    "specific_energy_kinematic_J_m3",
+    "specific_energy_kinematic_J_m3", "grains_inside_cutter_final",
 ]
 
 

@@ -219,7 +219,7 @@ def test_report_table_and_plots(tmp_path):
     assert list(t["penetration_mm"]) == [0.95, 1.9]
     assert list(t["n_grains"]) == [2000, 2001] and list(t["wall_s"]) == [60.0, 61.0]
     assert t["lateral_to_normal_ratio_1"].tolist() == pytest.approx([1 / 3, 1 / 3])
-    assert len(list((tmp_path / "out" / "plots").glob("*.png"))) == 3
+    assert len(list((tmp_path / "out" / "plots").glob("*.png"))) == 5  # 3 vs penetration, 2 vs spacing
 
 
 @pytest.mark.skipif(not SNAKEMAKE.exists() and not shutil.which("snakemake"), reason="snakemake not installed")

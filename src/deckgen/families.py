@@ -632,6 +632,12 @@ PLOTS: dict[str, tuple[str, list[str], list[str]]] = {
     "odc": ("frequency_hz", ["eccentricity_ratio_1", "speed_m_s"], ["force_magnitude_N_mean_steady",
                                                                    "contact_fraction_steady_1"]),
 }
+#: further (x, groups, ys) plots per family
+EXTRA_PLOTS: dict[str, list[tuple[str, list[str], list[str]]]] = {
+    "linear_ccs": [("spacing_mm", ["penetration_mm"], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady"])],
+    "indentation_asymmetric": [("disc_diameter_mm", ["rock", "cut_spacing_mm"], ["force_normal_N_peak"])],
+    "rotary": [("rotary_radius_mm", [], ["rolling_to_normal_ratio_1"])],
+}
 #: summary fields copied into the family table (beside the factors of index.csv)
 TABLE_FIELDS = [
     "n_grains", "n_bonds_initial", "steps", "dt_s", "wall_s", "particle_steps_per_s", "run_completed",
@@ -818,9 +824,8 @@ def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    x, groups, ys = PLOTS[family]
     files = []
-    for y in ys:
+    for x, groups, y in [(x, g, y) for x, g, ys in [PLOTS[family], *EXTRA_PLOTS.get(family, [])] for y in ys]:
         fig = Figure(figsize=(6.5, 4.2), dpi=120, layout="constrained")
         FigureCanvasAgg(fig)
         ax = fig.add_subplot(1, 1, 1)

@@ -290,25 +290,31 @@ class MicroParams:
     radius_multiplier: float = 1.0
     gap_tolerance: float = 0.05
     contact_modulus_ratio: float = 1.0  # Hertz contact modulus / E_b (with tie_contact_modulus)
+    clump_size: int = 1  # grains per clump (bonds.clump_size; 1 = no clumps)
+    clump_strength_factor: float = 100.0  # intra-clump bond strengths / sigma_c, tau_c (with clumps)
 
     def key(self) -> str:
         """Hash of the values rounded to 10 significant digits (folder and table key).
 
-        ``gap_tolerance`` enters only when it differs from 0.05, so points recorded before it was a
-        parameter keep their keys.
+        ``gap_tolerance``, ``contact_modulus_ratio`` and the clump fields enter only when they differ
+        from their defaults, so points recorded before they were parameters keep their keys.
         """
         vals = {k: float(f"{v:.10g}") for k, v in asdict(self).items()}
         if vals["gap_tolerance"] == 0.05:
             del vals["gap_tolerance"]
         if vals["contact_modulus_ratio"] == 1.0:
             del vals["contact_modulus_ratio"]
+        if vals["clump_size"] == 1:
+            del vals["clump_size"], vals["clump_strength_factor"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
-        """Case overrides (bonds.*, contact.*)."""
+        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1)."""
         bonds = {"youngs_modulus_GPa": self.youngs_modulus_GPa, "tensile_strength_MPa": self.tensile_strength_MPa,
                  "shear_strength_MPa": self.shear_strength_MPa, "radius_multiplier": self.radius_multiplier,
                  "gap_tolerance": self.gap_tolerance}
+        if self.clump_size != 1:
+            bonds.update(clump_size=int(self.clump_size), clump_strength_factor=self.clump_strength_factor)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

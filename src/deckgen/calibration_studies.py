@@ -111,9 +111,9 @@ def intra_clump_broken(run_dir: Path, parsed_dir: Path) -> dict[str, int]:
 def smoothed_peak(parsed_dir: Path, window_s: float) -> float:
     """Peak of the platen stress after a centred moving mean over ``window_s`` [s].
 
-    The raw series of a coarse specimen rings at about one P-wave transit (the jaw and platen loads of
-    the BTS discs swing by +-30 % between samples), so the raw peak is partly the ringing's; the mean
-    over a few transits is the load the specimen carries.
+    The raw series of a coarse specimen is noisy (the jaw loads of the BTS discs swing by up to +-30 %
+    between samples), so the raw peak is partly the noise's; the mean over a few P-wave transits is
+    closer to the load the specimen carries.
     """
     ts = pd.read_parquet(parsed_dir / "timeseries.parquet", columns=["time_s", "stress_Pa"])
     if len(ts) < 2:

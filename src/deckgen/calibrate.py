@@ -444,8 +444,9 @@ TAU_RATIO_START = 1.0
 #: E_b 20 GPa, interaction range g 0.4, contact modulus 4 E_b, sandstone density and quasi-static platen speeds,
 #: coarse grains, BTS the mean of three discs run until the load fell to 20 % of its peak. Rows:
 #: (sigma_c/E_b, tau_c/sigma_c, E/E_b, UCS/sigma_c, BTS/sigma_c). UCS/BTS: 5.9 at tau/sigma 1, 8.2 at 0.5,
-#: 12.7 at 0.25 (sigma_c/E_b 3e-3); at 6e-3: 6.3 at 0.5, 8.7 at 0.25. At fixed tau_c, sigma_c hardly moves UCS or
-#: BTS here (the bonds fail in shear): UCS/BTS follows the shear failure strain tau_c/E_b.
+#: 12.7 at 0.25 (sigma_c/E_b 3e-3); at 6e-3: 6.3 at 0.5, 8.7 at 0.25. UCS/BTS follows mainly the shear failure
+#: strain tau_c/E_b (the bonds fail mostly through their shear terms; sigma_c adds up to ~40 % at fixed tau_c).
+#: No point of this table reaches the sandstone or concrete targets: see docs/calibration.md, M = (UCS/BTS)(UCS/E).
 MICRO_MACRO_HIGH_STRAIN: tuple[tuple[float, float, float, float, float], ...] = (
     (3e-3, 1.0, 12.536 / 20, 59.156 / 60, 10.117 / 60),
     (3e-3, 0.5, 11.160 / 20, 32.118 / 60, 3.9075 / 60),

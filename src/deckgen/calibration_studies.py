@@ -80,6 +80,8 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     # tau_c = 60 MPa (tau_c/E_b 3e-3 as the base), sigma_c raised: how much does sigma_c matter at fixed tau_c?
     ("tau/sigma=0.25 at tau_c/E_b 3e-3 (sigma_c 240)", {"tensile_strength_MPa": 240.0}),
     ("tau/sigma=0.1 at tau_c/E_b 3e-3 (sigma_c 600)", {"tensile_strength_MPa": 600.0}),
+    # the two that raise M = (UCS/BTS)(UCS/E) most, together
+    ("clumps of 16, sigma_c 600 (tau/sigma=0.1)", {"clump_size": 16, "tensile_strength_MPa": 600.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

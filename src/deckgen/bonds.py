@@ -46,7 +46,7 @@ twisting torque :math:`\tfrac12\gamma_t\,\Delta\omega_\parallel`. For a damping 
 :math:`\gamma_r = 4\zeta\sqrt{I^* k_b}/L`, :math:`\gamma_t = 4\zeta\sqrt{I^* k_t}`.
 
 Clumps. Cho, Martin & Sego (2007, IJRMMS 44:997-1010) showed that a bonded-particle model of
-clumped grains (non-breakable clusters of discs) reaches realistic UCS/BTS ratios and friction
+clumped grains (non-breakable clusters of particles) reaches realistic UCS/BTS ratios and friction
 angles, where round grains stay far below them. :func:`grow_clumps` groups grains into clumps of at
 most ``clump_size`` bonded grains, deterministically from a seed; every bond between two grains of
 one clump is an intra-clump bond with its own bond types, its strengths multiplied by the clump
@@ -159,9 +159,9 @@ def grow_clumps(pairs: np.ndarray, n: int, clump_size: int, seed: int, x: np.nda
     pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
     if len(pairs) and (pairs.min() < 0 or pairs.max() >= n):
         raise ValueError(f"pairs refer to grains outside 0..{n - 1}")
-    label = np.full(n, -1, dtype=np.int64)
     if clump_size == 1:
         return np.arange(n, dtype=np.int64)
+    label = np.full(n, -1, dtype=np.int64)
     nbrs: list[list[int]] = [[] for _ in range(n)]
     for i, j in pairs:
         if i != j:

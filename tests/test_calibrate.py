@@ -88,6 +88,11 @@ def test_card_round_trip_and_case_overrides(tmp_path):
     ({"calibration": {"parameters": ["log_E_b", "log_tau_ratio", "gap_tolerance"]}}, "log_sigma_c is required"),
     ({"calibration": {"parameters": ["log_E_b", "log_sigma_c", "log_tau_ratio", "stiffness"]}}, "calibration.parameters.3"),
     ({"calibration": {"ucs_specimen": {"kind": "ucs_cylinder", "diameter_mm": 2}}}, "ucs_specimen / base"),
+    ({"calibration": {"bounds": {"log_tau_ratio": [-2.0, 0.5]}}}, "bounds: log_tau_ratio is not in parameters"),
+    ({"calibration": {"parameters": ["log_E_b", "log_sigma_c", "log_tau_ratio"], "bounds": {"log_tau_ratio": [0.5, -2.0]}}},
+     "bounds: log_tau_ratio: need finite lower < upper"),
+    ({"calibration": {"start_table": "medium"}}, "calibration.start_table: Input should be 'ratio' or 'high_strain'"),
+    ({"calibrated": {"bonds": {"clump_size": 0}}}, "calibrated.bonds: clump_size"),
 ])
 def test_bad_card_field_gives_clear_error(tmp_path, patch, expect):
     from deckgen.spec import deep_merge
@@ -125,6 +130,73 @@ def test_analytic_start_uses_the_interaction_range_for_high_ratios():
     # 10 (concrete): a moderate range
     assert 0.35 <= g.gap_tolerance <= 0.45 and g.tau_ratio < 0.5
     assert 0.2 < c.gap_tolerance < 0.45 and c.tau_ratio == 1.0
+
+
+def test_analytic_start_high_strain_reproduces_the_measured_points():
+    from deckgen.calibrate import (
+        HIGH_STRAIN_CONTACT_RATIO,
+        HIGH_STRAIN_GAP,
+        MICRO_MACRO_HIGH_STRAIN,
+        CardTargets,
+        micro_macro_high_strain,
+    )
+
+    space = ParameterSpace(["log_E_b", "log_sigma_c", "log_tau_ratio"], bounds={"log_tau_ratio": (math.log(0.1), 1.0)})
+    for strain, r, cE, cU, cB in MICRO_MACRO_HIGH_STRAIN:
+        sigma_c = 20e3 * strain  # MPa at E_b 20 GPa
+        t = CardTargets(density_kg_m3=2450, ucs_MPa=sigma_c * cU, bts_MPa=sigma_c * cB, youngs_modulus_GPa=20 * cE,
+                        poisson_ratio=0.2, citation="calibration_studies ratio --set high-strain")
+        p = analytic_start(t, None, space, table="high_strain")
+        assert p.gap_tolerance == HIGH_STRAIN_GAP and p.contact_modulus_ratio == HIGH_STRAIN_CONTACT_RATIO
+        # the table at the start's own failure strain gives the targets back
+        s = min(max(p.tensile_strength_MPa / (p.youngs_modulus_GPa * 1e3), 3e-3), 6e-3)
+        pE, pU, pB = micro_macro_high_strain(s, p.tau_ratio)
+        assert p.youngs_modulus_GPa * pE == pytest.approx(t.youngs_modulus_GPa, rel=0.02), (strain, r)
+        assert p.tensile_strength_MPa * pU == pytest.approx(t.ucs_MPa, rel=0.02), (strain, r)
+        assert p.tensile_strength_MPa * pB == pytest.approx(t.bts_MPa, rel=0.02), (strain, r)
+        if strain == 3e-3:  # where the fixed point starts: the measured point itself
+            assert p.youngs_modulus_GPa == pytest.approx(20.0, rel=0.02), (strain, r)
+            assert p.tensile_strength_MPa == pytest.approx(sigma_c, rel=0.02), (strain, r)
+            assert p.tau_ratio == pytest.approx(r, rel=0.02), (strain, r)
+        else:  # UCS/BTS follows tau_c/E_b: (6e-3, r) and (3e-3, ~2r) give nearly the same ratio
+            assert p.shear_strength_MPa / p.youngs_modulus_GPa == pytest.approx(r * strain * 1e3, rel=0.35)
+
+
+def test_high_strain_start_and_prior_for_sandstone():
+    from deckgen.calibrate import prior_jacobian
+
+    card = _card("sandstone")
+    space = ParameterSpace(["log_E_b", "log_sigma_c", "log_tau_ratio"])
+    p = analytic_start(card.targets, None, space, table="high_strain")
+    # UCS/BTS 13.8 at UCS/E 0.86 %: the table's failure strains (3e-3 to 6e-3) need tau_c/sigma_c below the
+    # measured 0.25; the start sits at the default bound 0.25 (1e-3 inside it), sigma_c/E_b above 6e-3
+    assert p.tau_ratio == pytest.approx(0.25, rel=0.01)
+    assert p.tensile_strength_MPa / (p.youngs_modulus_GPa * 1e3) > 6e-3
+    J = prior_jacobian(space, "high_strain")
+    k = space.names.index("log_tau_ratio")
+    # lowering tau_c/sigma_c lowers BTS faster than UCS (the measured mechanism), and E a little
+    assert J[1, k] > J[0, k] > J[2, k] > 0
+    assert J.shape == (3, 3) and np.all(np.isfinite(J))
+    with pytest.raises(ValueError, match="unknown table"):
+        analytic_start(card.targets, None, space, table="nope")
+
+
+def test_clump_fields_in_params_keys_and_overrides():
+    import hashlib
+    import json
+    from dataclasses import asdict
+
+    from deckgen.calibrate import CalibratedParams
+
+    p = MicroParams(20.0, 60.0, 15.0, gap_tolerance=0.4, contact_modulus_ratio=4.0)
+    # without clumps the key is the one recorded before the clump fields existed
+    old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_")}
+    assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
+    assert "clump_size" not in p.overrides()["bonds"]
+    q = MicroParams(20.0, 60.0, 15.0, clump_size=4, clump_strength_factor=50.0)
+    assert q.key() != MicroParams(20.0, 60.0, 15.0).key()
+    assert q.overrides()["bonds"]["clump_size"] == 4 and q.overrides()["bonds"]["clump_strength_factor"] == 50.0
+    CalibratedParams(bonds={k: float(v) for k, v in q.overrides()["bonds"].items()})  # a valid card block
 
 
 def test_parameter_space_round_trip_and_bounds():

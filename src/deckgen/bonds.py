@@ -45,6 +45,13 @@ twisting torque :math:`\tfrac12\gamma_t\,\Delta\omega_\parallel`. For a damping 
 :math:`\gamma_n = 2\zeta\sqrt{m^* k_r}`, :math:`\gamma_s = 2\zeta\sqrt{m^* k_s}`,
 :math:`\gamma_r = 4\zeta\sqrt{I^* k_b}/L`, :math:`\gamma_t = 4\zeta\sqrt{I^* k_t}`.
 
+Clumps. Cho, Martin & Sego (2007, IJRMMS 44:997-1010) showed that a bonded-particle model of
+clumped grains (non-breakable clusters of particles) reaches realistic UCS/BTS ratios and friction
+angles, where round grains stay far below them. :func:`grow_clumps` groups grains into clumps of at
+most ``clump_size`` bonded grains, deterministically from a seed; every bond between two grains of
+one clump is an intra-clump bond with its own bond types, its strengths multiplied by the clump
+strength factor (effectively unbreakable at 10-100) and its modulus by the clump stiffness factor.
+
 Time step. Central-difference integration is stable for :math:`\Delta t < 2/\omega_{max}`. Each
 grain gets its translational and rotational frequency from the sum over its bonds,
 :math:`\omega_{tr}^2 = \sum k_r / m` and :math:`\omega_{rot}^2 = \sum (0.75 k_s L^2 + k_b)/I`
@@ -138,6 +145,72 @@ def find_bond_pairs(x: np.ndarray, r: np.ndarray, gap_tolerance: float) -> np.nd
     return out[np.lexsort((out[:, 1], out[:, 0]))].astype(np.int64)
 
 
+def grow_clumps(pairs: np.ndarray, n: int, clump_size: int, seed: int, x: np.ndarray | None = None) -> np.ndarray:
+    """Clump label (0..n_clumps-1) of each of ``n`` grains, clumps grown on the bond graph ``pairs``.
+
+    Grains are visited in a random order drawn from ``seed``; each grain not yet in a clump starts
+    one, which grows one grain at a time to at most ``clump_size`` grains by adding the free grain
+    bonded to the most clump members (ties: nearest to the starting grain when ``x`` is given, then
+    the lower index). A clump that runs out of free bonded neighbours stays smaller, so every grain
+    is in exactly one clump and sizes are 1..clump_size. Deterministic for given inputs.
+    """
+    if clump_size < 1:
+        raise ValueError(f"clump_size must be >= 1, got {clump_size}")
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    if len(pairs) and (pairs.min() < 0 or pairs.max() >= n):
+        raise ValueError(f"pairs refer to grains outside 0..{n - 1}")
+    if clump_size == 1:
+        return np.arange(n, dtype=np.int64)
+    label = np.full(n, -1, dtype=np.int64)
+    nbrs: list[list[int]] = [[] for _ in range(n)]
+    for i, j in pairs:
+        if i != j:
+            nbrs[int(i)].append(int(j))
+            nbrs[int(j)].append(int(i))
+    order = np.random.default_rng(seed).permutation(n)
+    nxt = 0
+    for s0 in order:
+        s0 = int(s0)
+        if label[s0] >= 0:
+            continue
+        members = [s0]
+        label[s0] = nxt
+        links: dict[int, int] = {}  # free candidate -> bonds to clump members
+        for k in nbrs[s0]:
+            if label[k] < 0:
+                links[k] = links.get(k, 0) + 1
+        while len(members) < clump_size and links:
+            if x is not None:
+                d = {k: float(((x[k] - x[s0]) ** 2).sum()) for k in links}
+                pick = min(links, key=lambda k: (-links[k], d[k], k))
+            else:
+                pick = min(links, key=lambda k: (-links[k], k))
+            del links[pick]
+            label[pick] = nxt
+            members.append(pick)
+            for k in nbrs[pick]:
+                if label[k] < 0:
+                    links[k] = links.get(k, 0) + 1
+        nxt += 1
+    return label
+
+
+def clump_sizes(label: np.ndarray) -> dict[int, int]:
+    """Clump-size distribution: {size: number of clumps of that size}."""
+    if len(label) == 0:
+        return {}
+    sizes = np.bincount(np.asarray(label, dtype=np.int64))
+    sizes = sizes[sizes > 0]
+    u, c = np.unique(sizes, return_counts=True)
+    return {int(a): int(b) for a, b in zip(u, c)}
+
+
+def intra_clump(pairs: np.ndarray, label: np.ndarray) -> np.ndarray:
+    """Mask of the bonds whose two grains belong to the same clump."""
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    return label[pairs[:, 0]] == label[pairs[:, 1]]
+
+
 @dataclass
 class BondTable:
     """Bonds of a specimen, grouped into types whose coefficients are the bin means."""
@@ -148,6 +221,13 @@ class BondTable:
     r_bond: np.ndarray         # per-type mean bond radius [m]
     length: np.ndarray         # per-type mean bond length [m]
     per_atom: np.ndarray       # bonds per atom
+    n_plain_types: int | None = None  # types 1..n_plain_types are ordinary bonds, the rest intra-clump (None: all)
+
+    @property
+    def intra_types(self) -> list[int]:
+        """1-based bond types of intra-clump bonds (empty without clumps)."""
+        n = self.ntypes if self.n_plain_types is None else self.n_plain_types
+        return list(range(n + 1, self.ntypes + 1))
 
     @property
     def ntypes(self) -> int:
@@ -179,31 +259,61 @@ def make_bond_table(
     damping_ratio: float,
     bins_radius: int,
     bins_length: int,
+    intra: np.ndarray | None = None,
+    clump_strength_factor: float = 1.0,
+    clump_stiffness_factor: float = 1.0,
 ) -> BondTable:
     """Bin bonds by (bond radius, bond length) into types and compute per-type coefficients.
 
     LAMMPS holds coefficients per bond type, so a polydisperse packing gets one type per
     (radius bin, length bin); the within-bin spread (a few per cent) is reported by
-    :func:`binning_error`.
+    :func:`binning_error`. ``intra`` (a mask over ``pairs``) marks intra-clump bonds: they are
+    binned on their own into the types after the ordinary ones (``BondTable.n_plain_types``),
+    with sigma_c and tau_c times ``clump_strength_factor`` and E_b times ``clump_stiffness_factor``.
+    Without intra-clump bonds the table is the plain one.
     """
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    mask = np.zeros(len(pairs), bool) if intra is None else np.asarray(intra, dtype=bool)
+    if mask.shape != (len(pairs),):
+        raise ValueError(f"intra: expected a mask of {len(pairs)} bonds, got shape {mask.shape}")
+    if clump_strength_factor <= 0 or clump_stiffness_factor <= 0:
+        raise ValueError("clump_strength_factor and clump_stiffness_factor must be > 0")
     i, j = pairs[:, 0], pairs[:, 1]
     rb = radius_multiplier * np.minimum(r[i], r[j])
     L = np.linalg.norm(x[i] - x[j], axis=1)
-    key = _bins(rb, bins_radius) * max(bins_length, 1) + _bins(L, bins_length)
-    uniq, types0 = np.unique(key, return_inverse=True)
-    nt = len(uniq)
     inertia = 0.4 * mass * r**2
     m_eff = mass[i] * mass[j] / (mass[i] + mass[j])
     I_eff = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
-    cnt = np.bincount(types0, minlength=nt)
+    types = np.zeros(len(pairs), dtype=np.int64)
+    parts = []
+    offset = 0
+    for sel, e_f, s_f in ((~mask, 1.0, 1.0), (mask, clump_stiffness_factor, clump_strength_factor)):
+        if not sel.any():
+            continue
+        key = _bins(rb[sel], bins_radius) * max(bins_length, 1) + _bins(L[sel], bins_length)
+        uniq, types0 = np.unique(key, return_inverse=True)
+        nt = len(uniq)
+        cnt = np.bincount(types0, minlength=nt)
 
-    def mean(v: np.ndarray) -> np.ndarray:
-        return np.bincount(types0, weights=v, minlength=nt) / cnt
+        def mean(v: np.ndarray) -> np.ndarray:
+            return np.bincount(types0, weights=v[sel], minlength=nt) / cnt
 
-    rb_t, L_t = mean(rb), mean(L)
-    coeffs = bpm_coefficients(E_b, stiffness_ratio, sigma_c, tau_c, rb_t, L_t, mean(m_eff), mean(I_eff), damping_ratio)
+        rb_t, L_t = mean(rb), mean(L)
+        parts.append((rb_t, L_t, bpm_coefficients(E_b * e_f, stiffness_ratio, sigma_c * s_f, tau_c * s_f, rb_t, L_t,
+                                                   mean(m_eff), mean(I_eff), damping_ratio)))
+        types[sel] = types0 + 1 + offset
+        offset += nt
+    n_plain = len(parts[0][0]) if parts and (~mask).any() else 0
+    if parts:
+        coeffs = {k: np.concatenate([p[2][k] for p in parts]) for k in COEFF_NAMES}
+        rb_all = np.concatenate([p[0] for p in parts])
+        L_all = np.concatenate([p[1] for p in parts])
+    else:  # no bond at all: keep the shapes the plain path gave (empty types)
+        coeffs = {k: np.zeros(0) for k in COEFF_NAMES}
+        rb_all, L_all = np.zeros(0), np.zeros(0)
     per_atom = np.bincount(pairs.ravel(), minlength=len(r))
-    return BondTable(pairs=pairs, types=types0 + 1, coeffs=coeffs, r_bond=rb_t, length=L_t, per_atom=per_atom)
+    return BondTable(pairs=pairs, types=types, coeffs=coeffs, r_bond=rb_all, length=L_all, per_atom=per_atom,
+                     n_plain_types=n_plain)
 
 
 def binning_error(x: np.ndarray, r: np.ndarray, table: BondTable, radius_multiplier: float) -> float:

@@ -131,6 +131,15 @@ class CalibrationSetup(_Model):
     ucs_packings: int = Field(1, ge=1, le=10, description="UCS tests per evaluation (packing seeds), averaged.")
     bts_packings: int = Field(3, ge=1, le=10, description=(
         "BTS tests per evaluation (packing seeds), averaged: a coarse Brazilian disc scatters ~12 % over packings."))
+    start_table: Literal["ratio", "high_strain"] = Field(
+        "ratio", description=(
+            "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
+            "strain sigma_c/E_b 0.75e-3; UCS/BTS from the interaction range g) or 'high_strain' (sigma_c/E_b 3e-3 to "
+            "6e-3 at g 0.4 and E_c/E_b 4; UCS/BTS from a low tau_c/sigma_c), for rocks with UCS/E above ~0.5 %."))
+    bounds: dict[ParamName, tuple[float, float]] = Field(
+        default_factory=dict, description=(
+            "Bounds of optimiser parameters in the optimiser's units (log of the physical value for log_*), "
+            "overriding the defaults of deckgen.calibrate.PARAMS."))
     ucs_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_UCS), description="UCS specimen block.")
     bts_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_BTS), description="BTS specimen block.")
 
@@ -146,6 +155,11 @@ class CalibrationSetup(_Model):
                              "or gap_tolerance)")
         if "specimen" in self.base:
             raise ValueError("base: must not set specimen (use ucs_specimen / bts_specimen)")
+        for name, (lo, hi) in self.bounds.items():
+            if name not in self.parameters:
+                raise ValueError(f"bounds: {name} is not in parameters (fix: add it to parameters or drop its bounds)")
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ValueError(f"bounds: {name}: need finite lower < upper, got [{lo}, {hi}]")
         for name, sp, kind in (("ucs_specimen", self.ucs_specimen, "ucs_cylinder"),
                                ("bts_specimen", self.bts_specimen, "brazilian_disc")):
             if sp.get("kind") != kind:
@@ -290,25 +304,33 @@ class MicroParams:
     radius_multiplier: float = 1.0
     gap_tolerance: float = 0.05
     contact_modulus_ratio: float = 1.0  # Hertz contact modulus / E_b (with tie_contact_modulus)
+    clump_size: int = 1  # grains per clump (bonds.clump_size; 1 = no clumps)
+    clump_strength_factor: float = 100.0  # intra-clump bond strengths / sigma_c, tau_c (with clumps)
+    clump_stiffness_factor: float = 1.0  # intra-clump bond modulus / E_b (with clumps)
 
     def key(self) -> str:
         """Hash of the values rounded to 10 significant digits (folder and table key).
 
-        ``gap_tolerance`` enters only when it differs from 0.05, so points recorded before it was a
-        parameter keep their keys.
+        ``gap_tolerance``, ``contact_modulus_ratio`` and the clump fields enter only when they differ
+        from their defaults, so points recorded before they were parameters keep their keys.
         """
         vals = {k: float(f"{v:.10g}") for k, v in asdict(self).items()}
         if vals["gap_tolerance"] == 0.05:
             del vals["gap_tolerance"]
         if vals["contact_modulus_ratio"] == 1.0:
             del vals["contact_modulus_ratio"]
+        if vals["clump_size"] == 1:
+            del vals["clump_size"], vals["clump_strength_factor"], vals["clump_stiffness_factor"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
-        """Case overrides (bonds.*, contact.*)."""
+        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1)."""
         bonds = {"youngs_modulus_GPa": self.youngs_modulus_GPa, "tensile_strength_MPa": self.tensile_strength_MPa,
                  "shear_strength_MPa": self.shear_strength_MPa, "radius_multiplier": self.radius_multiplier,
                  "gap_tolerance": self.gap_tolerance}
+        if self.clump_size != 1:
+            bonds.update(clump_size=int(self.clump_size), clump_strength_factor=self.clump_strength_factor,
+                         clump_stiffness_factor=self.clump_stiffness_factor)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa
@@ -417,6 +439,25 @@ GAP_START_MAX = 0.8
 TAU_RATIO_START = 1.0
 
 
+#: Measured at high bond failure strain (``python -m deckgen.calibration_studies ratio --set high-strain --card
+#: cases/materials/sandstone.yaml --bts-packings 3 --bts-stop 0.2``; docs/calibration_runs/ratio_high_strain.csv):
+#: E_b 20 GPa, interaction range g 0.4, contact modulus 4 E_b, sandstone density and quasi-static platen speeds,
+#: coarse grains, BTS the mean of three discs run until the load fell to 20 % of its peak. Rows:
+#: (sigma_c/E_b, tau_c/sigma_c, E/E_b, UCS/sigma_c, BTS/sigma_c). UCS/BTS: 5.9 at tau/sigma 1, 8.2 at 0.5,
+#: 12.7 at 0.25 (sigma_c/E_b 3e-3); at 6e-3: 6.3 at 0.5, 8.7 at 0.25. UCS/BTS follows mainly the shear failure
+#: strain tau_c/E_b (the bonds fail mostly through their shear terms; sigma_c adds up to ~40 % at fixed tau_c).
+#: No point of this table reaches the sandstone or concrete targets: see docs/calibration.md, M = (UCS/BTS)(UCS/E).
+MICRO_MACRO_HIGH_STRAIN: tuple[tuple[float, float, float, float, float], ...] = (
+    (3e-3, 1.0, 12.536 / 20, 59.156 / 60, 10.117 / 60),
+    (3e-3, 0.5, 11.160 / 20, 32.118 / 60, 3.9075 / 60),
+    (3e-3, 0.25, 9.2551 / 20, 16.398 / 60, 1.2958 / 60),
+    (6e-3, 0.5, 12.743 / 20, 69.935 / 120, 11.149 / 120),
+    (6e-3, 0.25, 11.254 / 20, 31.344 / 120, 3.6006 / 120),
+)
+#: The interaction range and contact/bond modulus ratio the high-strain table was measured at.
+HIGH_STRAIN_GAP, HIGH_STRAIN_CONTACT_RATIO = 0.4, 4.0
+
+
 def _loglin(values: list[float], at: list[float], x: float) -> float:
     """Linear inter/extrapolation of log(values) over ``at`` (two or more points) at ``x``."""
     lv = np.log(values)
@@ -442,8 +483,59 @@ def micro_macro(g: float, r: float) -> tuple[float, float, float]:
     return tuple(math.exp(b + t - f) for b, t, f in zip(base, tau, ref))  # type: ignore[return-value]
 
 
+def micro_macro_high_strain(strain: float, r: float) -> tuple[float, float, float]:
+    """(E/E_b, UCS/sigma_c, BTS/sigma_c) of :data:`MICRO_MACRO_HIGH_STRAIN` at bond failure strain sigma_c/E_b
+    ``strain`` and tau_c/sigma_c ``r``: log-linear in log r at each measured strain, then in log strain
+    (extrapolated outside the measured ranges)."""
+    rows = np.array(MICRO_MACRO_HIGH_STRAIN)
+    levels = sorted(set(rows[:, 0]))
+    per_level = []
+    for lev in levels:
+        sub = rows[rows[:, 0] == lev]
+        sub = sub[np.argsort(sub[:, 1])]
+        per_level.append([_loglin(list(sub[:, c]), list(np.log(sub[:, 1])), math.log(r)) for c in (2, 3, 4)])
+    out = [_loglin([math.exp(v[c]) for v in per_level], list(np.log(levels)), math.log(strain)) for c in range(3)]
+    return tuple(math.exp(v) for v in out)  # type: ignore[return-value]
+
+
+def _start_high_strain(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroParams:
+    """Start from the high-strain table: tau_c/sigma_c for UCS/BTS, then E_b and sigma_c for E and BTS; the
+    bond failure strain sigma_c/E_b they imply (clipped to the measured 3e-3 to 6e-3) is fed back until it
+    settles (fixed point, 50 sweeps)."""
+    from scipy.optimize import brentq
+
+    lo_r, hi_r = 0.05, 4.0
+    if "log_tau_ratio" in sp.names:
+        k = sp.names.index("log_tau_ratio")
+        lo_r, hi_r = math.exp(sp.lo[k]), math.exp(sp.hi[k])
+    want = math.log(t.ucs_MPa / t.bts_MPa)
+    s_lo, s_hi = min(row[0] for row in MICRO_MACRO_HIGH_STRAIN), max(row[0] for row in MICRO_MACRO_HIGH_STRAIN)
+    strain = s_lo
+    r = 1.0
+    for _ in range(50):
+        def f(lr: float) -> float:
+            _, a, b = micro_macro_high_strain(strain, math.exp(lr))
+            return math.log(a / b) - want
+
+        a, b = math.log(lo_r), math.log(hi_r)
+        r = math.exp(brentq(f, a, b, xtol=1e-10)) if f(a) * f(b) < 0 else math.exp(a if abs(f(a)) < abs(f(b)) else b)
+        cE, _, cB = micro_macro_high_strain(strain, r)
+        # within the measured strains: the table's trend in strain is not extrapolated (it runs away)
+        new = min(max((t.bts_MPa / cB) / (t.youngs_modulus_GPa / cE * 1e3), s_lo), s_hi)
+        if abs(math.log(new / strain)) < 1e-9:
+            break
+        strain = new
+    cE, _, cB = micro_macro_high_strain(strain, r)
+    sigma_c = t.bts_MPa / cB
+    return MicroParams(
+        youngs_modulus_GPa=t.youngs_modulus_GPa / cE, tensile_strength_MPa=sigma_c, shear_strength_MPa=r * sigma_c,
+        friction=base.contact.friction, rolling_friction=base.contact.rolling_friction,
+        radius_multiplier=base.bonds.radius_multiplier, gap_tolerance=HIGH_STRAIN_GAP,
+        contact_modulus_ratio=HIGH_STRAIN_CONTACT_RATIO)
+
+
 def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None = None,
-                   space: ParameterSpace | None = None) -> MicroParams:
+                   space: ParameterSpace | None = None, table: str = "ratio") -> MicroParams:
     """Start micro-parameters from the measured micro-macro table (:func:`micro_macro`).
 
     The ratio UCS/BTS fixes the ratio knob(s): with ``gap_tolerance`` in ``space``, g on the rising
@@ -452,6 +544,9 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
     (if not free) stays there; without g, tau_c/sigma_c at the base case's g. Then
     E_b = E / (E/E_b) and sigma_c = BTS / (BTS/sigma_c). Friction, rolling friction and the bond
     radius multiplier come from the base case. Values are clipped into the bounds of ``space``.
+
+    ``table="high_strain"``: :func:`micro_macro_high_strain` instead (g 0.4 and E_c/E_b 4 as measured;
+    tau_c/sigma_c sets UCS/BTS, within the bounds of ``log_tau_ratio`` when it is free).
     """
     if base_case is None:
         base = Case()
@@ -461,6 +556,13 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         base = Case.model_validate(base_case)
     t = targets
     sp = space or ParameterSpace()
+    if table not in ("ratio", "high_strain"):
+        raise ValueError(f"analytic_start: unknown table {table!r} (fix: 'ratio' or 'high_strain')")
+    if table == "high_strain":
+        p = _start_high_strain(t, base, sp)
+        bounds = {n: (float(lo), float(hi)) for n, lo, hi in zip(sp.names, sp.lo, sp.hi)}
+        full = ParameterSpace(PARAM_NAMES, bounds=bounds)
+        return full.from_vector(full.clip_inside(full.to_vector(p), 1e-3), p)
     want = math.log(t.ucs_MPa / t.bts_MPa)
 
     def log_ratio(g: float, r: float) -> float:
@@ -498,9 +600,32 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
     return full.from_vector(full.clip_inside(full.to_vector(p), 1e-3), p)
 
 
-def prior_jacobian(space: ParameterSpace) -> np.ndarray:
+def _prior_high_strain(space: ParameterSpace) -> np.ndarray:
+    """Prior Jacobian from :data:`MICRO_MACRO_HIGH_STRAIN`: secants over tau_c/sigma_c 0.25-1 and over
+    sigma_c/E_b 3e-3 to 6e-3 (at tau/sigma 0.25-0.5); the other columns as in the 'ratio' prior."""
+    base = prior_jacobian(space, "ratio")
+    (E1, U1, B1), (E2, U2, B2) = micro_macro_high_strain(3e-3, 0.25), micro_macro_high_strain(3e-3, 1.0)
+    lr = math.log(4.0)
+    d_tau = [math.log(U2 / U1) / lr, math.log(B2 / B1) / lr, math.log(E2 / E1) / lr]
+    (Ea, Ua, Ba), (Eb, Ub, Bb) = micro_macro_high_strain(3e-3, 0.35), micro_macro_high_strain(6e-3, 0.35)
+    ls = math.log(2.0)
+    ds = [math.log(Ub / Ua) / ls, math.log(Bb / Ba) / ls, math.log(Eb / Ea) / ls]  # d log(ratio) / d log strain
+    cols = {"log_tau_ratio": d_tau,
+            # strain = sigma_c / E_b: UCS = sigma_c f(strain), E = E_b h(strain)
+            "log_sigma_c": [1.0 + ds[0], 1.0 + ds[1], ds[2]],
+            "log_E_b": [-ds[0], -ds[1], 1.0 - ds[2]]}
+    for k, n in enumerate(space.names):
+        if n in cols:
+            base[:, k] = cols[n]
+    return base
+
+
+def prior_jacobian(space: ParameterSpace, table: str = "ratio") -> np.ndarray:
     """d log(UCS, BTS, E) / d x of the measured micro-macro table (rows: outputs; columns: parameters),
-    as secants over the measured range (tau_c/sigma_c 0.5-2 at g = 0.05; g 0.05-0.4 at r = 1)."""
+    as secants over the measured range (tau_c/sigma_c 0.5-2 at g = 0.05; g 0.05-0.4 at r = 1);
+    ``table="high_strain"``: :func:`_prior_high_strain`."""
+    if table == "high_strain":
+        return _prior_high_strain(space)
     (E1, U1, B1), (E2, U2, B2) = micro_macro(0.05, 0.5), micro_macro(0.05, 2.0)
     (Eg0, Ug0, Bg0), (Eg1, Ug1, Bg1) = micro_macro(0.05, 1.0), micro_macro(0.4, 1.0)  # the rising branch
     lr = math.log(4.0)
@@ -861,7 +986,7 @@ class _Jacobian:
 def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, table_path: str | Path,
               tol: float = 0.05, max_evals: int = 30, *, space: ParameterSpace | None = None,
               card: MaterialCard | None = None, card_path: str | Path | None = None,
-              log: Callable[[str], None] | None = None) -> CalibrationResult:
+              log: Callable[[str], None] | None = None, prior: np.ndarray | None = None) -> CalibrationResult:
     """Find micro-parameters that give the targets' UCS, BTS and E within +-tol (see module doc).
 
     Every evaluation is appended to ``table_path`` (CSV) as soon as it is known. If the table
@@ -874,7 +999,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
     log = log or (lambda s: None)
     table_path = Path(table_path)
     t = targets.as_pa()
-    J0 = prior_jacobian(space)
+    J0 = prior_jacobian(space) if prior is None else np.asarray(prior, dtype=float)
     jac_est = _Jacobian(J0)
 
     recorded: dict[str, dict[str, Any]] = {}
@@ -1075,9 +1200,10 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
     card = load_card(card_path)
     out = Path(out)
     setup = card.calibration
-    space = ParameterSpace(setup.parameters)
+    space = ParameterSpace(setup.parameters, bounds=dict(setup.bounds))
     base = card.case_overrides()
-    start = analytic_start(card.targets, deep_merge(base, {"specimen": setup.ucs_specimen}), space)
+    start = analytic_start(card.targets, deep_merge(base, {"specimen": setup.ucs_specimen}), space,
+                           table=setup.start_table)
     if stand_in:
         evaluator: Any = StandInEvaluator()
     else:
@@ -1090,7 +1216,8 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
     log(f"{card.rock}: start E_b {start.youngs_modulus_GPa:.4g} GPa, sigma_c {start.tensile_strength_MPa:.4g} MPa, "
         f"tau_c {start.shear_strength_MPa:.4g} MPa; parameters {space.names}")
     res = calibrate(evaluator, card.targets, start, out / "evaluations.csv", tol=tol or setup.tol,
-                    max_evals=max_evals or setup.max_evals, space=space, card=card, card_path=out / "card.yaml", log=log)
+                    max_evals=max_evals or setup.max_evals, space=space, card=card, card_path=out / "card.yaml", log=log,
+                    prior=prior_jacobian(space, setup.start_table))
     e = res.errors
     log(f"{card.rock}: {'converged' if res.converged else 'NOT converged'} ({res.stop_reason}) after {res.n_evals} "
         f"evaluations ({res.new_evaluations} new): UCS {e['ucs']:+.1%}, BTS {e['bts']:+.1%}, E {e['E']:+.1%}")

@@ -2,8 +2,9 @@
 
 ``python -m deckgen.calibration_studies <study> ...``:
 
-- ``ratio``: how the bond shear/tensile strength ratio, contact friction, rolling friction and the
-  bond radius multiplier move UCS, BTS, E and UCS/BTS (one UCS + one BTS test per variant).
+- ``ratio``: how the bond shear/tensile strength ratio, contact friction, rolling friction, the
+  bond radius multiplier and clumps move UCS, BTS, E and UCS/BTS (one UCS + one BTS test per variant;
+  ``--set high-strain``: at sigma_c/E_b 3e-3, ``--card``: base case and speeds of a material card).
 - ``quasistatic``: a material card's calibrated point at its platen speeds and at half of them; the
   change of the peak stresses says whether the loading is quasi-static (issue #3 asks < 3 %).
 - ``seeds``: a calibrated card re-run on new packing seeds: mean, standard deviation and coefficient
@@ -54,6 +55,101 @@ RATIO_VARIANTS: list[tuple[str, dict[str, float]]] = [
     ("tau/sigma=1, interaction range gap 0.6 r", {"shear_strength_MPa": 30.0, "gap_tolerance": 0.6}),
 ]
 
+#: High bond failure strain (issue #3: sandstone and concrete need sigma_c/E_b of 3e-3 to 6e-3, where
+#: the interaction range and the contact modulus left UCS/BTS at 5-7.7). Base point: E_b 20 GPa,
+#: sigma_c = tau_c = 60 MPa (sigma_c/E_b = 3e-3), g 0.4, E_c/E_b 4; each variant changes one mechanism.
+HIGH_STRAIN_BASE = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0,
+                               gap_tolerance=0.4, contact_modulus_ratio=4.0)
+HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
+    ("base (sigma_c/E_b 3e-3, g 0.4, E_c/E_b 4, tau/sigma 1)", {}),
+    ("tau/sigma=0.5", {"shear_strength_MPa": 30.0}),
+    ("tau/sigma=0.25", {"shear_strength_MPa": 15.0}),
+    ("rolling friction 0.3", {"rolling_friction": 0.3}),
+    ("friction 1.0", {"friction": 1.0}),
+    ("clumps of 2", {"clump_size": 2}),
+    ("clumps of 4", {"clump_size": 4}),
+    ("clumps of 8", {"clump_size": 8}),
+    ("clumps of 4, intra-clump stiffness x10", {"clump_size": 4, "clump_stiffness_factor": 10.0}),
+    ("interaction range g 0.05", {"gap_tolerance": 0.05}),
+    ("clumps of 4, g 0.05", {"clump_size": 4, "gap_tolerance": 0.05}),
+    ("tau/sigma=0.5, sigma_c/E_b 6e-3", {"tensile_strength_MPa": 120.0, "shear_strength_MPa": 60.0}),
+    ("tau/sigma=0.25, sigma_c/E_b 6e-3", {"tensile_strength_MPa": 120.0, "shear_strength_MPa": 30.0}),
+    ("clumps of 16", {"clump_size": 16}),
+    ("clumps of 8, tau/sigma=0.5", {"clump_size": 8, "shear_strength_MPa": 30.0}),
+    ("clumps of 8, tau/sigma=0.25", {"clump_size": 8, "shear_strength_MPa": 15.0}),
+    # tau_c = 60 MPa (tau_c/E_b 3e-3 as the base), sigma_c raised: how much does sigma_c matter at fixed tau_c?
+    ("tau/sigma=0.25 at tau_c/E_b 3e-3 (sigma_c 240)", {"tensile_strength_MPa": 240.0}),
+    ("tau/sigma=0.1 at tau_c/E_b 3e-3 (sigma_c 600)", {"tensile_strength_MPa": 600.0}),
+    # the two that raise M = (UCS/BTS)(UCS/E) most, together
+    ("clumps of 16, sigma_c 600 (tau/sigma=0.1)", {"clump_size": 16, "tensile_strength_MPa": 600.0}),
+]
+#: Variant sets of the ratio study: (base point, variants, output name).
+RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
+    "default": (MicroParams(youngs_modulus_GPa=40.0, tensile_strength_MPa=30.0, shear_strength_MPa=60.0),
+                RATIO_VARIANTS, "ratio"),
+    "high-strain": (HIGH_STRAIN_BASE, HIGH_STRAIN_VARIANTS, "ratio_high_strain"),
+}
+
+
+def intra_clump_broken(run_dir: Path, parsed_dir: Path) -> dict[str, int]:
+    """Broken bonds of a run split into intra-clump and other bonds.
+
+    Intra-clump bonds are those whose type is in ``spec.json`` derived.clumps.intra_clump_bond_types
+    (bond types are read from the Bonds section of ``specimen.data``); the broken bonds are the
+    parsed ``broken`` table (atom-id pairs).
+    """
+    from deckgen.datafile import iter_section
+
+    spec = json.loads((run_dir / "spec.json").read_text())
+    intra_types = set(spec["derived"].get("clumps", {}).get("intra_clump_bond_types", []))
+    btype: dict[tuple[int, int], int] = {}
+    for _, parts in iter_section(run_dir / "specimen.data", "Bonds"):
+        a, b = int(parts[2]), int(parts[3])
+        btype[(min(a, b), max(a, b))] = int(parts[1])
+    broken = pd.read_parquet(parsed_dir / "broken.parquet", columns=["id1", "id2"])
+    types = [btype.get((min(a, b), max(a, b)), 0) for a, b in zip(broken["id1"], broken["id2"])]
+    n_intra = sum(t in intra_types for t in types)
+    return {"bonds": len(btype), "intra_bonds": sum(t in intra_types for t in btype.values()),
+            "broken": len(types), "broken_intra": int(n_intra), "broken_other": int(len(types) - n_intra)}
+
+
+def smoothed_peak(parsed_dir: Path, window_s: float) -> float:
+    """Peak of the platen stress after a centred moving mean over ``window_s`` [s].
+
+    The raw series of a coarse specimen is noisy (the jaw loads of the BTS discs swing by up to +-30 %
+    between samples), so the raw peak is partly the noise's; the mean over a few P-wave transits is
+    closer to the load the specimen carries.
+    """
+    ts = pd.read_parquet(parsed_dir / "timeseries.parquet", columns=["time_s", "stress_Pa"])
+    if len(ts) < 2:
+        return math.nan
+    step = float(np.median(np.diff(ts["time_s"].to_numpy())))
+    n = max(1, int(round(window_s / step))) if step > 0 else 1
+    return float(ts["stress_Pa"].rolling(n, center=True, min_periods=1).mean().max())
+
+
+def _smoothed(ev: DemEvaluator, p: MicroParams, E_Pa: float) -> dict[str, float]:
+    """Smoothed peaks (:func:`smoothed_peak`, window = SMOOTH_TRANSITS P-wave transits of the loaded length
+    at the measured E) of the UCS and BTS tests of a point, each the mean over its replicate packings."""
+    folder = ev.folder(p)
+    out: dict[str, float] = {}
+    for test in ("ucs", "bts"):
+        case = ev.case(p, test)
+        sp = case.specimen
+        length = (sp.height_mm if test == "ucs" else sp.diameter_mm) * 1e-3  # type: ignore[union-attr]
+        window = SMOOTH_TRANSITS * length / math.sqrt(E_Pa / case.material.density_kg_m3)
+        vals = [smoothed_peak(folder / (test if i == 0 else f"{test}_r{i}") / "parsed", window)
+                for i in range(ev.replicates[test])]
+        out[f"{test}_smoothed_Pa"] = float(np.mean(vals))
+        if len(vals) > 1:
+            out[f"{test}_smoothed_cv_1"] = float(np.std(vals, ddof=1) / np.mean(vals))
+    out["ucs_to_bts_smoothed_1"] = out["ucs_smoothed_Pa"] / out["bts_smoothed_Pa"]
+    return out
+
+
+#: Moving-mean window of the smoothed peaks, in P-wave transits of the loaded specimen length.
+SMOOTH_TRANSITS = 3.0
+
 
 def _summaries(ev: DemEvaluator, p: MicroParams) -> tuple[dict[str, Any], dict[str, Any]]:
     folder = ev.folder(p)
@@ -76,7 +172,21 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
             "bts_broken_tension": b.get("bonds_broken_tension"), "bts_broken_shear": b.get("bonds_broken_shear"),
             "ucs_grains": u.get("n_grains"), "bts_grains": b.get("n_grains"),
             "ucs_steps": u.get("steps"), "bts_steps": b.get("steps"),
+            "ucs_bonds_initial": u.get("n_bonds_initial"), "bts_bonds_initial": b.get("n_bonds_initial"),
+            "ucs_bonds_broken": u.get("bonds_broken"), "bts_bonds_broken": b.get("bonds_broken"),
         })
+        row.update(_smoothed(ev, p, r["E_Pa"]))
+        if ev.replicates["bts"] > 1:
+            vals = [json.loads((ev.folder(p) / (f"bts_r{i}" if i else "bts") / "parsed" / "summary.json").read_text())
+                    ["peak_stress_Pa"] for i in range(ev.replicates["bts"])]
+            row["bts_cv_1"] = float(np.std(vals, ddof=1) / np.mean(vals))
+        if p.clump_size > 1:  # did the intra-clump bonds hold?
+            folder = ev.folder(p)
+            for test in ("ucs", "bts"):
+                c = intra_clump_broken(folder / test / "run", folder / test / "parsed")
+                row.update({f"{test}_intra_clump_bonds": c["intra_bonds"], f"{test}_broken_intra_clump": c["broken_intra"]})
+                spec = json.loads((folder / test / "run" / "spec.json").read_text())
+                row[f"{test}_clump_sizes"] = json.dumps(spec["derived"]["clumps"]["size_distribution"])
     return row
 
 
@@ -96,19 +206,34 @@ def _write(rows: list[dict[str, Any]], out: Path, name: str, title: str, cols: l
 
 def ratio_study(out: Path, *, base: dict[str, Any] | None = None, ucs: dict[str, Any] | None = None,
                 bts: dict[str, Any] | None = None, cache: Path | None = None,
-                command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
-    """One UCS + BTS pair per variant of :data:`RATIO_VARIANTS` (calibration specimens, coarse grains, 0.1 m/s)."""
+                command: list[str] | None = None, parallel: bool = False, variant_set: str = "default",
+                only: list[str] | None = None, bts_packings: int = 1) -> pd.DataFrame:
+    """One UCS + BTS pair per variant of a set in :data:`RATIO_SETS` (calibration specimens, coarse grains;
+    default base and specimens: density 2650, 0.1 m/s). ``only``: run the variants whose label starts
+    with one of these strings (the table holds those)."""
+    if variant_set not in RATIO_SETS:
+        raise ValueError(f"ratio: unknown variant set {variant_set!r} (fix: one of {', '.join(RATIO_SETS)})")
+    p0, variants, name = RATIO_SETS[variant_set]
     base = base or {"material": {"density_kg_m3": 2650}, "packing": dict(COARSE_PACKING)}
     ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}
     bts = bts or {**DEFAULT_BTS, "platen_speed_m_s": 0.1}
-    ev = DemEvaluator(base, ucs, bts, out / "work", cache=cache, command=command, name="ratio", parallel=parallel)
-    p0 = MicroParams(youngs_modulus_GPa=40.0, tensile_strength_MPa=30.0, shear_strength_MPa=60.0)
+    ev = DemEvaluator(base, ucs, bts, out / "work", cache=cache, command=command, name="ratio", parallel=parallel,
+                      bts_packings=bts_packings)
+    if only:
+        variants = [(lab, ch) for lab, ch in variants if any(lab.startswith(o) for o in only)]
+        if not variants:
+            raise ValueError(f"ratio: --only {only} matches no variant of {variant_set!r}")
     rows = []
-    for label, change in RATIO_VARIANTS:
+    for label, change in variants:
         rows.append(_row(label, ev, replace(p0, **change)))
-        print(f"ratio: {label}: UCS/BTS {rows[-1]['ucs_to_bts_1']:.3g}", flush=True)
-    return _write(rows, out, "ratio", "UCS/BTS mechanisms (deckgen.calibration_studies ratio)",
-                  ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_to_bts_1", "poisson_ratio_1",
+        r = rows[-1]
+        print(f"{name}: {label}: UCS {r['ucs_Pa'] / MPA:.4g} MPa, BTS {r['bts_Pa'] / MPA:.4g} MPa, "
+              f"E {r['E_Pa'] / GPA:.4g} GPa, UCS/BTS {r['ucs_to_bts_1']:.3g}, smoothed "
+              f"{r.get('ucs_to_bts_smoothed_1', math.nan):.3g} ({r['wall_s']:.0f} s)", flush=True)
+    return _write(rows, out, name, f"UCS/BTS mechanisms, set {variant_set} (deckgen.calibration_studies ratio)",
+                  ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_to_bts_1", "ucs_smoothed_Pa", "bts_smoothed_Pa",
+                   "ucs_to_bts_smoothed_1", "bts_cv_1", "poisson_ratio_1",
+                   "ucs_bonds_broken", "bts_bonds_broken", "ucs_broken_intra_clump", "bts_broken_intra_clump",
                    "bts_broken_tension", "bts_broken_shear", "ucs_broken_tension", "ucs_broken_shear"])
 
 
@@ -121,7 +246,9 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
                     shear_strength_MPa=b["shear_strength_MPa"], friction=c.get("friction", 0.5),
                     rolling_friction=c.get("rolling_friction", 0.1), radius_multiplier=b.get("radius_multiplier", 1.0),
                     gap_tolerance=b.get("gap_tolerance", 0.05),
-                    contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"])
+                    contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
+                    clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
+                    clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0))
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 
@@ -244,6 +371,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--jobs", type=int, choices=[1, 2], default=1,
                     help="2: run the UCS and BTS tests of a point at the same time (1 rank each unless --ranks)")
     ap.add_argument("--write", default=None, help="table: also write the markdown here")
+    ap.add_argument("--set", dest="variant_set", default="default", choices=sorted(RATIO_SETS),
+                    help="ratio: variant set (high-strain: sigma_c/E_b 3e-3, g 0.4, E_c/E_b 4)")
+    ap.add_argument("--card", default=None, help="ratio: take the base case and the quasi-static specimens from "
+                    "this material card (one packing per test) instead of density 2650 at 0.1 m/s")
+    ap.add_argument("--only", default=None, help="ratio: comma-separated label prefixes of the variants to run")
+    ap.add_argument("--bts-packings", type=int, default=1, help="ratio: BTS discs (packing seeds) per variant, averaged")
+    ap.add_argument("--ucs-stop", type=float, default=None, help="ratio: UCS stop_fraction_of_peak (default: the specimen's)")
+    ap.add_argument("--bts-stop", type=float, default=None, help="ratio: BTS stop_fraction_of_peak (default: the specimen's)")
     a = ap.parse_args(argv)
     ranks = a.ranks or (1 if a.jobs == 2 else None)
     command = shlex.split(a.engine_cmd) if a.engine_cmd else (engine_command(ranks) if ranks else None)
@@ -251,7 +386,20 @@ def main(argv: list[str] | None = None) -> int:
     out, cache = Path(a.out), (Path(a.cache) if a.cache else None)
     try:
         if a.study == "ratio":
-            print(ratio_study(out, cache=cache, command=command, parallel=par).to_string())
+            base = ucs = bts = None
+            if a.card:
+                card = load_card(a.card)
+                base = card.case_overrides()
+                ucs, bts = quasi_static_specimens(card)
+            only = [o.strip() for o in a.only.split(",")] if a.only else None
+            ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}
+            bts = bts or {**DEFAULT_BTS, "platen_speed_m_s": 0.1}
+            if a.ucs_stop is not None:
+                ucs = {**ucs, "stop_fraction_of_peak": a.ucs_stop}
+            if a.bts_stop is not None:
+                bts = {**bts, "stop_fraction_of_peak": a.bts_stop}
+            print(ratio_study(out, base=base, ucs=ucs, bts=bts, cache=cache, command=command, parallel=par,
+                              variant_set=a.variant_set, only=only, bts_packings=a.bts_packings).to_string())
         elif a.study == "table":
             text = results_table([Path(c) for c in a.cards], out)
             print(text)

@@ -19,8 +19,11 @@ from deckgen import __version__
 from deckgen.bonds import (
     COEFF_NAMES,
     binning_error,
+    clump_sizes,
     contact_timestep,
     find_bond_pairs,
+    grow_clumps,
+    intra_clump,
     make_bond_table,
     stable_timestep,
 )
@@ -343,11 +346,17 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     r = r_full * (1.0 - b.shrink_before_bonding)
     rho = case.material.density_kg_m3 * run.mass_scaling
     mass = rho * 4.0 / 3.0 * math.pi * r**3
+    clumps = None
+    intra = None
+    if b.clump_size > 1 and b.enabled:  # clumps grown on the bond graph from the packing seed
+        clumps = grow_clumps(pairs, len(r_full), b.clump_size, seed=case.packing.seed, x=atoms.x)
+        intra = intra_clump(pairs, clumps)
     table = make_bond_table(
         atoms.x, r, mass, pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
         sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
         radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
-        bins_radius=b.type_bins_radius, bins_length=b.type_bins_length)
+        bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
+        intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
@@ -405,6 +414,17 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     }
     if not b.enabled:
         derived["bonded"] = False
+    if clumps is not None and intra is not None:
+        dist = clump_sizes(clumps)
+        multi = {k: v for k, v in dist.items() if k > 1}
+        derived["clumps"] = {
+            "clump_size": b.clump_size, "size_distribution": {str(k): v for k, v in dist.items()},
+            "n_clumps": int(sum(multi.values())), "grains_in_clumps": int(sum(k * v for k, v in multi.items())),
+            "grains_in_clumps_fraction": float(sum(k * v for k, v in multi.items()) / len(r)),
+            "mean_clump_size": float(sum(k * v for k, v in multi.items()) / max(1, sum(multi.values()))),
+            "intra_clump_bonds": int(intra.sum()), "intra_clump_bond_types": table.intra_types,
+            "strength_factor": b.clump_strength_factor, "stiffness_factor": b.clump_stiffness_factor,
+        }
     types = np.ones(len(r), dtype=int)
     x_all, r_all, rho_all = atoms.x, r, np.full(len(r), rho)
     n_atom_types = 1

@@ -108,11 +108,31 @@ class Bonds(_Model):
     damping_ratio: float = _f(0.05, "1", "Bond damping as a fraction of critical (normal, shear, roll, twist).", ge=0, le=2)
     type_bins_radius: int = _f(6, "1", "Bond types: bins of bond radius.", ge=1, le=20)
     type_bins_length: int = _f(4, "1", "Bond types: bins of bond length.", ge=1, le=20)
+    clump_size: int = _f(
+        1, "1", "Clumped grains (Cho, Martin & Sego 2007): grains per clump, grown on the bond graph from the packing "
+        "seed; bonds inside a clump get their own bond types with clump_strength_factor and clump_stiffness_factor. "
+        "1 = no clumps.", ge=1, le=20,
+    )
+    clump_strength_factor: float = _f(
+        100.0, "1", "Intra-clump bonds: tensile and shear strengths are this many times the bond strengths "
+        "(10-100: effectively unbreakable). Used only with clump_size > 1.", ge=1, le=1e6,
+    )
+    clump_stiffness_factor: float = _f(
+        1.0, "1", "Intra-clump bonds: Young's modulus is this many times E_b (> 1 stiffens the clumps and shortens the "
+        "time step). Used only with clump_size > 1.", ge=0.1, le=100,
+    )
     enabled: bool = Field(
         True, description="False: an unbonded granular specimen (the same packing and radius shrink, no bond; "
         "cross-engine checks). Written to spec.json only when false.",
         json_schema_extra={"unit": "1"}, exclude_if=lambda v: v is True,
     )
+
+    @model_validator(mode="after")
+    def _clumps(self) -> "Bonds":
+        if self.clump_size > 1 and not self.enabled:
+            raise ValueError("clump_size: clumps are made of bonds; an unbonded specimen (enabled: false) has none "
+                             "(fix: clump_size: 1, or enabled: true)")
+        return self
 
 
 # --------------------------------------------------------------------------- contact

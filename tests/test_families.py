@@ -315,3 +315,21 @@ def test_family_regression_recovers_seed001_form_on_runs():
     fr = r[r["response"] == "force_rolling_N_mean_steady"]
     assert 0.5 < fr["r_squared"].iloc[0] < 1.0  # the S^2 term is not in the linear form
     assert fam.family_regression("rotary", tab).empty
+
+
+@pytest.mark.skipif(not SNAKEMAKE.exists() and not shutil.which("snakemake"), reason="snakemake not installed")
+def test_snakemake_plans_the_trend_subsets(tmp_path):
+    """family_<family>_trends runs exactly the reduced cases marked trend_subset in index.csv (TREND_SUBSETS)."""
+    exe = str(SNAKEMAKE) if SNAKEMAKE.exists() else "snakemake"
+    targets = [f"family_{f}_trends" for f in NAMES]
+    res = subprocess.run([exe, "-n", *targets, "--config", f"results={tmp_path / 'r'}"],
+                         cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    text = " ".join((res.stdout + res.stderr).split())
+    n = sum(len(v) for v in fam.TREND_SUBSETS.values())
+    assert n == 17
+    for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
+        assert f"{rule} {count}" in text, (rule, count, text[-1500:])
+    for names in fam.TREND_SUBSETS.values():
+        for name in names:
+            assert f"{name}/run/in.deck" in text

@@ -13,6 +13,24 @@ FAMILY_CASES = {
     for fam in FAMILIES
     for scale in FAMILY_SCALES
 }
+
+
+def _trend_subset(fam):
+    """Reduced cases marked trend_subset in cases/<family>/index.csv (deckgen.families.TREND_SUBSETS)."""
+    import csv
+
+    index = Path("cases", fam, "index.csv")
+    if not index.is_file():
+        return {}
+    with index.open() as fh:
+        names = [r["case"] for r in csv.DictReader(fh) if r.get("trend_subset") == "1"]
+    return {n: FAMILY_CASES[(fam, "reduced")][n] for n in names if n in FAMILY_CASES[(fam, "reduced")]}
+
+
+#: scale "trends": the reduced cases that carry the seeds' trends at the least cost (family_<family>_trends)
+for _fam in FAMILIES:
+    FAMILY_CASES[(_fam, "trends")] = _trend_subset(_fam)
+FAMILY_SCALES = ["full", "reduced", "trends"]
 CASE_FILES = dict(DEFAULT_CASES)
 for _cases in FAMILY_CASES.values():
     for _name, _path in _cases.items():

@@ -2,13 +2,14 @@
 # per-case rules (pack -> render -> run -> parse -> plot); per family and scale the runs are aggregated
 # (deckgen aggregate) and reported (factors, grains, wall time, forces; force-vs-factor plots):
 #   snakemake --cores 2 family_odc_reduced        (or family_<family>_<scale>)
+#   snakemake --cores 2 family_odc_trends         (the reduced cases that carry the seeds' trends, cheapest)
 # Outputs: <results>/families/<family>_<scale>/{tables/*.csv|parquet, family_table.csv, plots/*.png}.
 # Not part of the default target.
 
 
 wildcard_constraints:
     family="|".join(FAMILIES),
-    scale="full|reduced",
+    scale="full|reduced|trends",
 
 
 rule family_aggregate:

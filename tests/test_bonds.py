@@ -145,3 +145,34 @@ def test_bond_types_are_bin_means():
         assert t.r_bond[k] == pytest.approx(rb)
         assert float(t.coeffs["F_rc"][k]) == pytest.approx(SIG * math.pi * rb**2)
     assert t.per_atom.sum() == 2 * len(pairs)
+
+
+def test_concurrent_jobs_make_a_shared_packing_once(tmp_path, monkeypatch):
+    """Two jobs needing the same packing: the second waits for the first and reuses its folder (no shared .tmp)."""
+    import json
+    import threading
+    import time
+    from pathlib import Path
+
+    from deckgen import packing as pk
+    from deckgen.spec import load_case
+
+    case = load_case(Path(__file__).resolve().parent / "data" / "cases" / "tiny_ucs.yaml")
+    calls = []
+
+    def fake_make(case, folder, *, progress, command):
+        calls.append(threading.get_ident())
+        time.sleep(0.5)
+        folder.mkdir(parents=True)
+        (folder / "packed.data").write_text("x")
+        (folder / "packing.json").write_text(json.dumps({"key": "k"}))
+        return folder
+
+    monkeypatch.setattr(pk, "_make_packing", fake_make)
+    out = []
+    threads = [threading.Thread(target=lambda: out.append(pk.ensure_packing(case, tmp_path, progress=False))) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(calls) == 1 and len(out) == 2 and out[0] == out[1] == pk.packing_dir(case, tmp_path)

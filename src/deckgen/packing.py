@@ -276,11 +276,24 @@ def packing_dir(case: Case, root: Path | None = None) -> Path:
 
 def ensure_packing(case: Case, root: Path | None = None, *, progress: bool = True, command: list[str] | None = None) -> Path:
     """Return the folder holding packed.data and packing.json, running the engine if not cached."""
-    from deckgen.runner import run_deck
+    import fcntl
 
     folder = packing_dir(case, root)
     if (folder / "packing.json").is_file() and (folder / "packed.data").is_file():
         return folder
+    # Two jobs that need the same packing (e.g. cases that differ only in their cutter) would share the
+    # .tmp folder and kill each other's engine run: the second waits on a per-key lock, then reuses it.
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    with open(folder.with_name(folder.name + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if (folder / "packing.json").is_file() and (folder / "packed.data").is_file():
+            return folder
+        return _make_packing(case, folder, progress=progress, command=command)
+
+
+def _make_packing(case: Case, folder: Path, *, progress: bool, command: list[str] | None) -> Path:
+    from deckgen.runner import run_deck
+
     tmp = folder.with_name(folder.name + ".tmp")
     if tmp.exists():
         shutil.rmtree(tmp)

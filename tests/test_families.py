@@ -263,18 +263,21 @@ def _linear_table(fn_of_s, ratio_of_p, seed=0):
     for S in (3.125, 6.375, 9.5, 12.5):
         for p in (0.95, 1.9, 3.2, 3.8):
             fn = fn_of_s(S) * (1 + 0.02 * rng.standard_normal())
-            rows.append({"case": f"c{S}_{p}", "spacing_mm": S, "penetration_mm": p, "force_normal_N_mean_steady": fn,
+            rows.append({"case": f"c{S}_{p}", "spacing_mm": S, "penetration_mm": p, "spacing_full_mm": 8 * S,
+                         "penetration_full_mm": 2 * p, "force_normal_N_mean_steady": fn,
                          "rolling_to_normal_ratio_1": ratio_of_p(p) * (1 + 0.02 * rng.standard_normal())})
     return pd.DataFrame(rows)
 
 
 def test_trend_table_finds_the_seed_trends_and_their_size():
-    """Fn = 100 + 8 S (+60 % over S 3.1-12.5) and Fr/Fn = 0.1 p: both trends hold, with their sizes and p-values."""
+    """Fn = 100 + 8 S and Fr/Fn = 0.1 p (reduced units): both trends hold, with their sizes over the seed's ranges
+    (S 25-100 mm, p 1.9-7.6 mm at full scale, i.e. 3.125-12.5 and 0.95-3.8 mm reduced) and p-values."""
     t = fam.trend_table("linear_ccs", _linear_table(lambda S: 100 + 8 * S, lambda p: 0.1 * p)).set_index("trend")
     fn, fr = t.loc["fn_rises_with_s"], t.loc["fr_fn_rises_with_p"]
     assert fn["runs"] == 16 and fn["groups"] == 4
-    assert fn["slope"] == pytest.approx(8.0, rel=0.1)
+    assert fn["slope"] == pytest.approx(1.0, rel=0.1)  # per mm of full-scale S (8 per reduced mm)
     assert fn["change_1"] == pytest.approx(8 * (12.5 - 3.125) / (100 + 8 * 3.125), rel=0.1)
+    assert fn["x_range_seed"] == "25-100" and not fn["extrapolated"]
     assert fn["p_value"] < 1e-6 and bool(fn["sign_as_seed"]) and bool(fn["significant_5pct"])
     assert fr["change_1"] == pytest.approx(3.8 / 0.95 - 1, rel=0.1) and bool(fr["sign_as_seed"])
     assert fn["seed_change_1"] == pytest.approx(193.8 / 122.4 - 1)  # seed 001 Tables 3-4
@@ -292,14 +295,31 @@ def test_odc_trend_keeps_only_nu_below_one_and_half_a_cycle():
     rows = [  # (frequency, nu, cycles in window, force): s11-like short window drops out of the second trend
         ("a", 90, 0.88, 0.27, 20.0), ("b", 180, 0.44, 0.54, 60.0), ("c", 240, 0.33, 0.72, 34.0),
         ("d", 270, 0.30, 0.81, 26.0), ("e", 90, 1.77, 0.27, 130.0), ("f", 0, float("inf"), 0.0, 178.0)]
-    tab = pd.DataFrame([{"case": c, "frequency_hz": f, "velocity_ratio_nu_1": nu, "cycles_in_window_1": cy,
-                         "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": 0.4, "speed_m_s": 2.0}
-                        for c, f, nu, cy, F in rows])
+    tab = pd.DataFrame([{"case": c, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
+                         "cycles_in_window_1": cy, "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": 0.4,
+                         "speed_full_m_s": 0.5} for c, f, nu, cy, F in rows])
     t = fam.trend_table("odc", tab).set_index("trend")
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 4
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "runs"] == 3
     assert bool(t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "sign_as_seed"])
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "change_1"] < -0.4
+    # runs at 45-67.5 rev/s (full-scale units) do not span the seed's 22.5-67.5: the change is extrapolated
+    assert bool(t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "extrapolated"])
+
+
+def test_trend_change_is_taken_over_the_seeds_range():
+    """Rotary runs on the seed's own log-linear line, over a wider r range, give the seed's change over 250-1000 mm."""
+    import numpy as np
+    import pandas as pd
+
+    r = np.array([250.0, 500.0, 1000.0, 2000.0])  # the line stays positive up to ~2.7 m
+    a, b = 19.9, (8.1 - 19.9) / np.log(1000 / 250)  # side force line through the seed's two points
+    tab = pd.DataFrame({"case": [f"r{x:g}" for x in r], "rotary_radius_full_mm": r,
+                        "force_side_N_mean_steady": -(a + b * np.log(r / 250)),
+                        "rolling_to_normal_ratio_1": 0.2 - 0.01 * np.log(r / 250)})
+    t = fam.trend_table("rotary", tab).set_index("trend")
+    assert t.loc["fs_falls_with_r", "change_1"] == pytest.approx(8.1 / 19.9 - 1, rel=1e-6)
+    assert t.loc["fs_falls_with_r", "change_1"] == pytest.approx(t.loc["fs_falls_with_r", "seed_change_1"], rel=1e-6)
 
 
 def test_family_regression_recovers_seed001_form_on_runs():

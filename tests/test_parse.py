@@ -591,3 +591,43 @@ def test_grains_inside_cutter_follows_the_cutter_path():
     pts = np.array([centre + 0.8 * R * ahead, centre + 0.8 * R * side, centre - [0, 0, 0.8 * R]])
     assert grains_inside_cutter(pts, rot, t) == 2  # in the disc plane yes, along the axis no
     assert phi > 0.05  # the yaw is large enough for the test to tell the axes apart
+
+
+@pytest.mark.parametrize("cutter", [
+    {"kind": "cone_disc", "diameter_mm": 20, "small_diameter_mm": 10, "clearance_angle_deg": 9, "rake_angle_deg": 30,
+     "tip_radius_mm": 0, "shell_radius_mm": 0.25},
+    {"kind": "v_disc", "diameter_mm": 12, "edge_angle_deg": 60, "tip_radius_mm": 0.3, "hub_width_mm": 4,
+     "shell_radius_mm": 0.25, "tilt_deg": 8},
+])
+def test_grains_inside_cutter_with_a_tilted_spinning_axis(cutter):
+    """Points just inside / outside the true (tilted) cutter surface, moved with the deck's motion (spin, oscillation):
+    the leak check counts exactly the inner ones, at several times."""
+    import json
+
+    import numpy as np
+
+    from deckgen.deck import cutter_world_points
+    from deckgen.geometry import build_cutter
+    from deckgen.results import grains_inside_cutter
+    from deckgen.spec import Cutter
+
+    golden = Path(__file__).resolve().parent / "data" / "golden"
+    spec = json.loads((golden / "tiny_cut" / "spec.json").read_text())  # oscillation with rolling spin
+    spec["case"]["cutter"] = {**Cutter().model_dump(), **cutter}
+    from types import SimpleNamespace
+
+    from deckgen.deck import cutter_modifications, cutter_params
+
+    holder = SimpleNamespace(cutter=Cutter.model_validate(spec["case"]["cutter"]))
+    kind, prm = cutter_params(holder)
+    mesh = build_cutter(kind, prm, **cutter_modifications(holder))
+    rng = np.random.default_rng(0)
+    idx = rng.choice(len(mesh.vertices), min(400, len(mesh.vertices)), replace=False)
+    v, n = mesh.vertices[idx], mesh.vertex_normals[idx]
+    cut = spec["derived"]["cutter"]
+    assert cut["spin_rate"] != 0 and cut["ecc"] > 0
+    for t in (0.0, 0.4 * cut["duration"], cut["duration"]):
+        inner = cutter_world_points(v - 30e-6 * n, cut, t)  # mesh vertices are offsets from the start centre
+        outer = cutter_world_points(v + 30e-6 * n, cut, t)
+        assert grains_inside_cutter(inner, spec, t) >= 0.97 * len(idx)  # sharp edges: a few normals point off
+        assert grains_inside_cutter(outer, spec, t) <= 0.03 * len(idx)

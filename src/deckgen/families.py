@@ -87,7 +87,11 @@ def _tag(x: float) -> str:
 
 
 def calibrated_card(rock: str) -> dict[str, Any] | None:
-    """The ``calibrated`` block of cases/materials/<rock>.yaml when its calibration converged, else None."""
+    """The micro-parameters of cases/materials/<rock>.yaml when its calibration converged, else None.
+
+    ``{"bonds": ..., "contact": ...}``: the card's ``calibration.base`` blocks with the ``calibrated``
+    values over them; without a calibrated contact modulus, E_c = E_b when the calibration tied them,
+    else the base's (or the spec default)."""
     from deckgen.render import repo_root
 
     path = repo_root() / "cases" / "materials" / f"{rock}.yaml"
@@ -96,7 +100,16 @@ def calibrated_card(rock: str) -> dict[str, Any] | None:
     card = yaml.safe_load(path.read_text())
     if not (card.get("provenance") or {}).get("converged") or not card.get("calibrated"):
         return None
-    return card["calibrated"]
+    from deckgen.spec import Contact
+
+    cal, setup = card["calibrated"], card.get("calibration") or {}
+    base = setup.get("base") or {}
+    bonds = {**(base.get("bonds") or {}), **(cal.get("bonds") or {})}
+    contact = {**(base.get("contact") or {}), **(cal.get("contact") or {})}
+    if "youngs_modulus_GPa" not in contact:
+        contact["youngs_modulus_GPa"] = (bonds["youngs_modulus_GPa"] if setup.get("tie_contact_modulus", True)
+                                         else Contact().youngs_modulus_GPa)
+    return {"bonds": bonds, "contact": contact}
 
 
 def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str, Any], dict[str, Any], list[str]]:
@@ -111,9 +124,7 @@ def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str,
     """
     card = calibrated_card(rock)
     if card:
-        b = {k: float(v) for k, v in card["bonds"].items()}
-        c = {k: float(v) for k, v in (card.get("contact") or {}).items()}
-        c.setdefault("youngs_modulus_GPa", b["youngs_modulus_GPa"])
+        b, c = dict(card["bonds"]), dict(card["contact"])
         source = f"calibrated card cases/materials/{rock}.yaml (issue #3; calibrated at its own grain size)"
     else:
         k_e = ROCKS[rock]["youngs_modulus_GPa"] / SMOKE_E_GPA
@@ -129,8 +140,11 @@ def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str,
         for key in ("youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa"):
             b[key] = b[key] / F
         c["youngs_modulus_GPa"] = c["youngs_modulus_GPa"] / F
-    b = {k: _r(v, 4) for k, v in b.items()}
-    c = {k: _r(v, 4) for k, v in c.items()}
+    def num(v: Any) -> Any:
+        return _r(float(v), 4) if isinstance(v, (int, float)) and not isinstance(v, bool) else v
+
+    b = {k: num(v) for k, v in b.items()}
+    c = {k: num(v) for k, v in c.items()}
     text = (f"Bonds: {source}: E_b {b['youngs_modulus_GPa']} GPa, sigma_c {b['tensile_strength_MPa']} MPa, tau_c "
             f"{b['shear_strength_MPa']} MPa, contact E {c['youngs_modulus_GPa']} GPa"
             + (f"; softened: moduli and strengths / {_r(F, 3)} (failure strains kept, dt x{_r(math.sqrt(F), 2)}; forces are "
@@ -696,8 +710,10 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
 class Trend:
     """A trend the seed reports, tested on a family's runs: y against x within groups of fixed factors.
 
-    ``expect`` is the sign the seed reports (+1 rises, -1 falls); ``seed_change`` the seed's relative
-    change of y over its x range (with ``seed_note`` saying where it comes from)."""
+    ``x`` is a full-scale (seed-unit) factor column of index.csv, so reduced and full runs share the
+    seed's x range ``x_range``; ``expect`` is the sign the seed reports (+1 rises, -1 falls);
+    ``seed_change`` the seed's relative change of y over ``x_range`` (``seed_note`` says where it
+    comes from). The runs' change is taken over the same range."""
 
     id: str
     text: str
@@ -707,6 +723,7 @@ class Trend:
     expect: int
     seed_change: float
     seed_note: str
+    x_range: tuple[float, float] = (0.0, 0.0)
     log_x: bool = False
     abs_y: bool = False
     only: str = ""  # pandas query selecting the runs the trend is about ("" = all)
@@ -716,41 +733,42 @@ class Trend:
 TRENDS: dict[str, tuple[Trend, ...]] = {
     "indentation_asymmetric": (
         Trend("fn_rises_with_t", "maximum normal force rises with the cut spacing t", "force_normal_N_peak",
-              "cut_spacing_mm", ("rock", "disc_diameter_mm"), +1, 1.0,
+              "cut_spacing_full_mm", ("rock", "disc_diameter_full_mm"), +1, 1.0,
               "seed 000 sec. 3.3 (Fig. 16 text): 'increasing the cut spacing from 15 to 25 mm causes an almost "
-              "twofold increase in the pressing force' (taken as +100 %)"),
+              "twofold increase in the pressing force' (taken as +100 %)", x_range=(15, 25)),
         Trend("fn_rises_with_d", "maximum normal force rises with the disc diameter D", "force_normal_N_peak",
-              "disc_diameter_mm", ("rock", "cut_spacing_mm"), +1, 0.15,
-              "seed 000 sec. 3.3: D 150 -> 160 mm raises the pressing force by about 15 %"),
+              "disc_diameter_full_mm", ("rock", "cut_spacing_full_mm"), +1, 0.15,
+              "seed 000 sec. 3.3: D 150 -> 160 mm raises the pressing force by about 15 %", x_range=(150, 160)),
     ),
     "linear_ccs": (
         Trend("fn_rises_with_s", "mean normal force rises with the spacing S", "force_normal_N_mean_steady",
-              "spacing_mm", ("penetration_mm",), +1, 193.8 / 122.4 - 1,
-              "seed 001 Tables 3-4, LS-DYNA at p 6.4 mm: 122.4 kN at S 25 mm -> 193.8 kN at S 100 mm"),
+              "spacing_full_mm", ("penetration_full_mm",), +1, 193.8 / 122.4 - 1,
+              "seed 001 Tables 3-4, LS-DYNA at p 6.4 mm: 122.4 kN at S 25 mm -> 193.8 kN at S 100 mm", x_range=(25, 100)),
         Trend("fr_fn_rises_with_p", "Fr/Fn rises with the penetration p", "rolling_to_normal_ratio_1",
-              "penetration_mm", ("spacing_mm",), +1, (31.7 / 208.6) / (9.3 / 118.4) - 1,
-              "seed 001 Table 4, LS-DYNA at S 100 mm: Fr/Fn 9.3/118.4 at p 1.9 mm -> 31.7/208.6 at p 7.6 mm"),
+              "penetration_full_mm", ("spacing_full_mm",), +1, (31.7 / 208.6) / (9.3 / 118.4) - 1,
+              "seed 001 Table 4, LS-DYNA at S 100 mm: Fr/Fn 9.3/118.4 at p 1.9 mm -> 31.7/208.6 at p 7.6 mm",
+              x_range=(1.9, 7.6)),
     ),
     "rotary": (
         Trend("fs_falls_with_r", "side force falls with the path radius r", "force_side_N_mean_steady",
-              "rotary_radius_mm", (), -1, 8.1 / 19.9 - 1,
+              "rotary_radius_full_mm", (), -1, 8.1 / 19.9 - 1,
               "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: side force 19.9 kN at r 250 mm -> 8.1 kN at r 1000 mm",
-              log_x=True, abs_y=True),
+              x_range=(250, 1000), log_x=True, abs_y=True),
         Trend("fr_fn_falls_with_r", "Fr/Fn falls with the path radius r", "rolling_to_normal_ratio_1",
-              "rotary_radius_mm", (), -1, (16.1 / 143.1) / (22.3 / 105.0) - 1,
+              "rotary_radius_full_mm", (), -1, (16.1 / 143.1) / (22.3 / 105.0) - 1,
               "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: Fr/Fn 22.3/105.0 at r 250 -> 16.1/143.1 at r 1000 mm",
-              log_x=True),
+              x_range=(250, 1000), log_x=True),
     ),
     "odc": (
         Trend("f_falls_with_freq_nu_lt_1", "mean force falls with the oscillation frequency when nu < 1",
-              "force_magnitude_N_mean_steady", "frequency_hz", ("eccentricity_ratio_1", "speed_m_s"), -1,
+              "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1,
               "seed 003 Table 5.1, e/R 0.4, 0.5 m/s: 636 N at 22.5 rev/s -> 442.3 N at 67.5 rev/s (the thesis "
-              "states -38 %)", only="velocity_ratio_nu_1 < 1 and frequency_hz > 0"),
+              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0"),
         Trend("f_falls_with_freq_nu_lt_1_half_cycle", "the same, only runs whose steady window holds at least half an "
               "oscillation cycle (a mean over a fraction of a cycle depends on the phase)",
-              "force_magnitude_N_mean_steady", "frequency_hz", ("eccentricity_ratio_1", "speed_m_s"), -1,
-              442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)",
+              "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
+              442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
               only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
     ),
 }
@@ -759,8 +777,10 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
 def trend_table(family: str, table: "Any") -> "Any":
     """Each trend of ``family`` fitted on the runs: pooled OLS y ~ x + group effects (statsmodels).
 
-    Columns: runs and groups used, pooled slope and its p-value, the mean relative change of y over
-    the x range within groups (fitted line), the seed's, and whether the sign is the seed's."""
+    Columns: runs and groups used, pooled slope and its p-value (when there are more runs than
+    parameters), the relative change of y along the pooled line over the seed's x range (mean over
+    groups; ``extrapolated`` when the runs do not span that range), the seed's, and whether the sign
+    is the seed's."""
     import numpy as np
     import pandas as pd
     import statsmodels.formula.api as smf
@@ -780,29 +800,38 @@ def trend_table(family: str, table: "Any") -> "Any":
         usable = t.groupby("_g")["_x"].transform("nunique") >= 2
         t = t[usable]
         row = {"family": family, "trend": tr.id, "description": tr.text, "y": tr.y, "x": tr.x + (" (log)" if tr.log_x else ""),
+               "x_range_seed": f"{tr.x_range[0]:g}-{tr.x_range[1]:g}",
                "runs": int(len(t)), "groups": int(t["_g"].nunique()), "expected_sign": tr.expect,
                "seed_change_1": tr.seed_change, "seed_source": tr.seed_note}
         if len(t) < 2:
             rows.append({**row, "slope": float("nan"), "p_value": float("nan"), "change_1": float("nan"),
                          "sign_as_seed": None, "significant_5pct": None})
             continue
-        changes = []
-        for _, g in t.groupby("_g"):
-            b, a = np.polyfit(g["_x"], g["_y"], 1)
-            y0, y1 = a + b * g["_x"].min(), a + b * g["_x"].max()
-            changes.append((y1 - y0) / abs(y0) if y0 != 0 else float("nan"))
-        formula = "_y ~ _x" + (" + C(_g)" if t["_g"].nunique() > 1 else "")
+        # fixed-effects slope (the same as OLS with a dummy per group): within-group deviations
+        dx = t["_x"] - t.groupby("_g")["_x"].transform("mean")
+        dy = t["_y"] - t.groupby("_g")["_y"].transform("mean")
+        slope = float((dx * dy).sum() / (dx * dx).sum())
         dof = len(t) - (1 + t["_g"].nunique())
+        pval = float("nan")
         if dof >= 1:
+            formula = "_y ~ _x" + (" + C(_g)" if t["_g"].nunique() > 1 else "")
             fit = smf.ols(formula, data=t).fit()
             slope, pval = float(fit.params["_x"]), float(fit.pvalues["_x"])
-        else:  # as many parameters as runs: the slope is exact, no p-value
-            slope, pval = float(np.mean([np.polyfit(g["_x"], g["_y"], 1)[0] for _, g in t.groupby("_g")])), float("nan")
+        # relative change of each group's line over the seed's x range, averaged over the groups
+        x0, x1 = (np.log(v) for v in tr.x_range) if tr.log_x else tr.x_range
+        changes = []
+        for _, g in t.groupby("_g"):
+            y0 = g["_y"].mean() + slope * (x0 - g["_x"].mean())
+            changes.append(slope * (x1 - x0) / abs(y0) if y0 != 0 else float("nan"))
+        xs = t[tr.x]
+        extrapolated = bool(xs.min() > min(tr.x_range) * 1.001 or xs.max() < max(tr.x_range) * 0.999)
         rows.append({**row, "slope": slope, "p_value": pval, "change_1": float(np.nanmean(changes)),
+                     "runs_x_min": float(xs.min()), "runs_x_max": float(xs.max()), "extrapolated": extrapolated,
                      "sign_as_seed": bool(np.sign(slope) == tr.expect),
                      "significant_5pct": (bool(pval < 0.05) if pval == pval else None)})
-    cols = ["family", "trend", "description", "y", "x", "runs", "groups", "slope", "p_value", "change_1", "seed_change_1",
-            "sign_as_seed", "significant_5pct", "expected_sign", "seed_source"]
+    cols = ["family", "trend", "description", "y", "x", "x_range_seed", "runs", "groups", "slope", "p_value", "change_1",
+            "seed_change_1", "runs_x_min", "runs_x_max", "extrapolated", "sign_as_seed", "significant_5pct", "expected_sign",
+            "seed_source"]
     return pd.DataFrame(rows, columns=cols)
 
 

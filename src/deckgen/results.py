@@ -592,15 +592,16 @@ def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int
     A grain touching the shell from outside keeps its centre at least its radius outside the true
     surface (the shell spheres sit their own radius inside it), so a centre inside the body means the
     grain got through a gap of the shell or through a part ``shell_coverage: near_rock`` left out.
-    The cutter body is the axisymmetric profile about its (yawing) axis; None where that does not
-    hold (tilted axis, cone disc with clearance) or the geometry cannot be rebuilt.
+    The body is the revolved profile about the disc axis, moved as the deck moves it: the axis
+    (tilted by a clearance angle or ``tilt_deg``) spins about y with the disc and yaws on a rotary
+    path. None when the geometry cannot be rebuilt from the spec.
     """
     from types import SimpleNamespace
 
     from matplotlib.path import Path as MplPath
 
-    from deckgen.deck import cutter_params
-    from deckgen.geometry import _coerce_params, wear_flat
+    from deckgen.deck import cutter_modifications, cutter_params
+    from deckgen.geometry import _coerce_params, build_cutter, wear_flat
     from deckgen.spec import MM, Cutter
 
     case, cut = spec["case"], spec["derived"].get("cutter") or {}
@@ -608,20 +609,27 @@ def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int
         cutter = Cutter.model_validate(case["cutter"])
     except Exception:  # a spec.json of another version: no check rather than a wrong one
         return None
-    if cutter.tilt_deg or (cutter.kind == "cone_disc" and cutter.clearance_angle_deg) or not cut:
+    if not cut:
         return None
-    kind, prm = cutter_params(SimpleNamespace(cutter=cutter))
+    holder = SimpleNamespace(cutter=cutter)
+    kind, prm = cutter_params(holder)
     prof = wear_flat(_coerce_params(kind, prm).profile(), cutter.wear_flat_mm * MM)
+    axis0 = np.array([0.0, 1.0, 0.0])
+    if cutter.tilt_deg or (cutter.kind == "cone_disc" and cutter.clearance_angle_deg):
+        axis0 = np.asarray(build_cutter(kind, prm, **cutter_modifications(holder)).metadata["deckgen_axis"], float)
+    th = cut.get("spin_rate", 0.0) * t  # the deck's spin: X1 = X cos th + Z sin th, Z1 = -X sin th + Z cos th
+    axis = np.array([axis0[0] * math.cos(th) + axis0[2] * math.sin(th), axis0[1],
+                     -axis0[0] * math.sin(th) + axis0[2] * math.cos(th)])
     if cut.get("rotary_radius"):
         phi = cut["yaw_rate"] * t
         centre = np.array([cut["axis_x"] + cut["rotary_radius"] * math.sin(phi),
                            cut["axis_y"] - cut["rotary_radius"] * math.cos(phi), cut["zc0"]])
-        axis = np.array([-math.sin(phi), math.cos(phi), 0.0])
+        axis = np.array([axis[0] * math.cos(phi) - axis[1] * math.sin(phi),
+                         axis[0] * math.sin(phi) + axis[1] * math.cos(phi), axis[2]])
     else:
         ind, e, w, V = cut["mode_indent"], cut["ecc"], cut["omega"], cut["V"]
         centre = np.array([cut["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0)), cut["yc0"],
                            cut["zc0"] - ind * V * t + (1 - ind) * e * math.sin(w * t)])
-        axis = np.array([0.0, 1.0, 0.0])
     d = np.asarray(xyz, float) - centre
     a = d @ axis
     rho = np.linalg.norm(d - np.outer(a, axis), axis=1)

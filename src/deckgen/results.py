@@ -90,7 +90,7 @@ UNITLESS_COLUMNS = frozenset({
     "case", "engine", "test", "mode", "step", "id", "id1", "id2", "btype", "sample_step",
     "bonds_intact", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
-    "n_grains_bonded", "n_grains_missing_final", "steps", "final_step", "damage_step",
+    "n_grains_bonded", "n_grains_missing_final", "grains_inside_cutter_final", "steps", "final_step", "damage_step",
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
     "notes", "log_failure",

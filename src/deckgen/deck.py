@@ -91,6 +91,14 @@ def cutter_modifications(case: Case) -> dict[str, float]:
     return {"wear": case.cutter.wear_flat_mm * MM, "tilt_deg": case.cutter.tilt_deg}
 
 
+def cutter_profile(case: Case) -> np.ndarray:
+    """The (worn) cross-section profile of the case's cutter: (radius, axial) vertices [m] of the revolved body."""
+    from deckgen.geometry import _coerce_params, wear_flat
+
+    kind, prm = cutter_params(case)
+    return wear_flat(_coerce_params(kind, prm).profile(), case.cutter.wear_flat_mm * MM)
+
+
 def neighbour_groove_mask(case: Case, x: np.ndarray) -> np.ndarray:
     """Grains whose centres lie in the grooves of the same (worn) disc cut at y = +-S beforehand.
 
@@ -99,14 +107,11 @@ def neighbour_groove_mask(case: Case, x: np.ndarray) -> np.ndarray:
     """
     from matplotlib.path import Path as MplPath
 
-    from deckgen.geometry import _coerce_params, wear_flat
-
     S = case.kinematics.neighbour_spacing_mm
     sp = case.specimen
     if S is None or not isinstance(sp, CuttingBlock):
         return np.zeros(len(x), bool)
-    kind, prm = cutter_params(case)
-    prof = wear_flat(_coerce_params(kind, prm).profile(), case.cutter.wear_flat_mm * MM)
+    prof = cutter_profile(case)
     R = float(prof[:, 0].max())
     zc = sp.height_mm * MM - case.kinematics.penetration_mm * MM + R
     poly = MplPath(prof)

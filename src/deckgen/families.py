@@ -785,13 +785,14 @@ def trend_table(family: str, table: "Any") -> "Any":
     import pandas as pd
     import statsmodels.formula.api as smf
 
+    table = table.copy()
+    for c in table.columns:  # numeric columns as numbers (index.csv writes 'inf' for nu without oscillation)
+        num = pd.to_numeric(table[c], errors="coerce")
+        if num.notna().sum() == table[c].replace("", np.nan).notna().sum():
+            table[c] = num
     rows = []
     for tr in TRENDS.get(family, ()):
-        t = table.copy()
-        for c in t.columns:  # numeric columns as numbers (index.csv writes 'inf' for nu without oscillation)
-            num = pd.to_numeric(t[c], errors="coerce")
-            if num.notna().sum() == t[c].replace("", np.nan).notna().sum():
-                t[c] = num
+        t = table
         if tr.only:
             t = t.query(tr.only)
         t = t.dropna(subset=[tr.x, tr.y])

@@ -600,9 +600,9 @@ def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int
 
     from matplotlib.path import Path as MplPath
 
-    from deckgen.deck import cutter_modifications, cutter_params
-    from deckgen.geometry import _coerce_params, build_cutter, wear_flat
-    from deckgen.spec import MM, Cutter
+    from deckgen.deck import cutter_modifications, cutter_params, cutter_profile, cutter_world_points
+    from deckgen.geometry import build_cutter
+    from deckgen.spec import Cutter
 
     case, cut = spec["case"], spec["derived"].get("cutter") or {}
     try:
@@ -612,24 +612,16 @@ def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int
     if not cut:
         return None
     holder = SimpleNamespace(cutter=cutter)
-    kind, prm = cutter_params(holder)
-    prof = wear_flat(_coerce_params(kind, prm).profile(), cutter.wear_flat_mm * MM)
+    prof = cutter_profile(holder)
     axis0 = np.array([0.0, 1.0, 0.0])
     if cutter.tilt_deg or (cutter.kind == "cone_disc" and cutter.clearance_angle_deg):
-        axis0 = np.asarray(build_cutter(kind, prm, **cutter_modifications(holder)).metadata["deckgen_axis"], float)
-    th = cut.get("spin_rate", 0.0) * t  # the deck's spin: X1 = X cos th + Z sin th, Z1 = -X sin th + Z cos th
-    axis = np.array([axis0[0] * math.cos(th) + axis0[2] * math.sin(th), axis0[1],
-                     -axis0[0] * math.sin(th) + axis0[2] * math.cos(th)])
-    if cut.get("rotary_radius"):
-        phi = cut["yaw_rate"] * t
-        centre = np.array([cut["axis_x"] + cut["rotary_radius"] * math.sin(phi),
-                           cut["axis_y"] - cut["rotary_radius"] * math.cos(phi), cut["zc0"]])
-        axis = np.array([axis[0] * math.cos(phi) - axis[1] * math.sin(phi),
-                         axis[0] * math.sin(phi) + axis[1] * math.cos(phi), axis[2]])
-    else:
-        ind, e, w, V = cut["mode_indent"], cut["ecc"], cut["omega"], cut["V"]
-        centre = np.array([cut["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0)), cut["yc0"],
-                           cut["zc0"] - ind * V * t + (1 - ind) * e * math.sin(w * t)])
+        axis0 = np.asarray(build_cutter(*cutter_params(holder), **cutter_modifications(holder)).metadata["deckgen_axis"],
+                           float)
+    # the deck's rigid motion (deckgen.deck.cutter_world_points) carries the centre and the axis tip;
+    # spec.json files from before the rotary path lack its keys (no spin, no yaw)
+    path = {"spin_rate": 0.0, "rotary_radius": 0.0, "yaw_rate": 0.0, "axis_x": 0.0, "axis_y": 0.0, **cut}
+    centre, tip = cutter_world_points(np.array([[0.0, 0.0, 0.0], axis0]), path, t)
+    axis = tip - centre
     d = np.asarray(xyz, float) - centre
     a = d @ axis
     rho = np.linalg.norm(d - np.outer(a, axis), axis=1)

@@ -37,7 +37,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 83 + 2 * len(NAMES)  # 83 case files + index.csv and README.md per family
+    assert len(files) == 86 + 2 * len(NAMES)  # 86 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -51,7 +51,7 @@ def test_case_counts_per_family():
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 16,
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
-        ("odc", "full"): 10, ("odc", "reduced"): 9,
+        ("odc", "full"): 10, ("odc", "reduced"): 12,  # 9 of Table 5.1 + 3 supplementary
     }
 
 
@@ -177,7 +177,13 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
     assert sorted(set(c.kinematics.neighbour_spacing_mm for c in _cases("linear_ccs", "reduced"))) == [3.125, 6.375, 9.5, 12.5]
     assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25, 62.5, 125, 375]
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
+    sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):
+        if c.name in sup:  # no full-scale twin: the stated seed-unit values x4
+            e, f, v = sup[c.name]
+            assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(4 * v), pytest.approx(4 * f))
+            assert c.kinematics.eccentricity_mm == pytest.approx(10 * e)
+            continue
         f = fulls[c.name.replace("_red_", "_")]
         assert c.kinematics.speed_m_s == pytest.approx(4 * f.kinematics.speed_m_s)
         assert c.kinematics.frequency_hz == pytest.approx(4 * f.kinematics.frequency_hz)
@@ -307,6 +313,27 @@ def test_odc_trend_keeps_only_nu_below_one_and_half_a_cycle():
     assert bool(t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "extrapolated"])
 
 
+def test_odc_nu_above_one_trend_expects_no_fall():
+    """The supplementary nu > 1 series: 'as the seed' means no significant slope; a clear fall is not."""
+    import pandas as pd
+
+    def table(forces):
+        rows = [(180, 1.77, 0.54), (240, 1.33, 0.72), (270, 1.18, 0.81), (90, 3.54, 0.27)]
+        return pd.DataFrame([{"case": f"x{i}", "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
+                              "cycles_in_window_1": cy, "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": 0.1,
+                              "speed_full_m_s": 0.5} for i, ((f, nu, cy), F) in enumerate(zip(rows, forces))])
+
+    flat = fam.trend_table("odc", table([15.0, 16.5, 14.8, 3.0])).set_index("trend").loc["f_flat_with_freq_nu_gt_1"]
+    assert flat["runs"] == 3 and flat["expected_sign"] == 0  # the 0.27-cycle run is left out
+    assert flat["p_value"] > 0.05 and bool(flat["sign_as_seed"])
+    falls = fam.trend_table("odc", table([30.0, 20.0, 15.2, 3.0])).set_index("trend").loc["f_flat_with_freq_nu_gt_1"]
+    assert falls["p_value"] < 0.05 and not bool(falls["sign_as_seed"])
+    cases = {c.name: c for c in fam.odc()}
+    assert {"odc_red_s101", "odc_red_s102", "odc_red_s103"} <= set(cases) and "odc_full_s101" not in cases
+    nus = [cases[f"odc_red_s{k}"].factors["velocity_ratio_nu_1"] for k in (101, 102, 103)]
+    assert nus == [1.768, 1.326, 1.179]
+
+
 def test_trend_change_is_taken_over_the_seeds_range():
     """Rotary runs on the seed's own log-linear line, over a wider r range, give the seed's change over 250-1000 mm."""
     import numpy as np
@@ -347,7 +374,7 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
     n = sum(len(v) for v in fam.TREND_SUBSETS.values())
-    assert n == 17
+    assert n == 20
     for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
         assert f"{rule} {count}" in text, (rule, count, text[-1500:])
     for names in fam.TREND_SUBSETS.values():

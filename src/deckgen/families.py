@@ -481,6 +481,12 @@ SEED003_SIMS = (
     (11, 0.4, 22.5, 0.5, 9), (12, 0.4, 45.0, 0.5, 9), (13, 0.4, 60.0, 0.5, 9), (14, 0.4, 67.5, 0.5, 9),
     (15, 0.2, 22.5, 0.5, 9), (16, 0.1, 22.5, 0.5, 9), (19, 0.4, 4.5, 0.1, 9),
 )
+#: Not in seed 003: a nu > 1 frequency series (e/R 0.1 at 0.5 m/s and 45/60/67.5 rev/s: nu 1.77/1.33/1.18) at the
+#: frequencies of the nu < 1 series (sims 12-14), so both series hold the same 0.5-0.8 cycles in a reduced window.
+#: Seed 003 states the force "only decreases when backwards movement exist[s]" (nu < 1) from an eccentricity series
+#: at 22.5 rev/s; at reduced scale 22.5 rev/s leaves 0.27 cycles in the window, too few for a mean.
+#: Sim labels 101-103 mark them as supplementary (index.csv column seed_sim).
+ODC_SUPPLEMENTARY = ((101, 0.1, 45.0, 0.5, 9), (102, 0.1, 60.0, 0.5, 9), (103, 0.1, 67.5, 0.5, 9))
 ODC_R_MM = 10.0
 ODC_SPEEDUP = 4.0  # reduced scale: forward speed and frequency x4 (nu = V/(e w) unchanged)
 
@@ -490,7 +496,7 @@ def odc() -> list[CaseDef]:
     rock = "savonniere_limestone"
     out: list[CaseDef] = []
     for scale in SCALES:
-        for sim, ecc, rev_s, V, clr in SEED003_SIMS:
+        for sim, ecc, rev_s, V, clr in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ()):
             if scale == "reduced" and sim == 19:
                 continue  # 4.5 rev/s at 0.1 m/s: < 0.3 cycles in a reduced block (docs/families.md)
             e_mm = _r(ecc * ODC_R_MM, 3)
@@ -525,8 +531,10 @@ def odc() -> list[CaseDef]:
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
                 outputs = {"series_every": 100, "bond_state_every": 5000}
+                what = (f"Table 5.1 sim {sim}." if sim < 100 else
+                        f"supplementary case {sim} (not in Table 5.1): a nu > 1 frequency series beside sims 12-14.")
                 header = [
-                    f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): Table 5.1 sim {sim}.",
+                    f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): {what}",
                     f"Geometry factor 1 for the disc (cone 20/10 mm, rake 30, clearance {clr} deg), depth 4 mm and e = {e_mm} mm",
                     f"(ratio {ecc}); grains r 0.7-1.0 mm (full: 0.65-0.95). Block trimmed to {L} x {W} x {H} mm (7 x 7 x 2 cm full), {travel} mm",
                     f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
@@ -574,11 +582,12 @@ def case_text(c: CaseDef) -> str:
 
 
 #: reduced cases that carry the trends of issue #4 at the least cost (``family_<family>_trends`` targets):
-#: linear S 25/51/100 at p 6.4 and p 1.9/6.4/7.6 at S 100; ODC no oscillation, nu < 1 at 45/60/67.5 rev/s and
-#: nu = 3.5; rotary r 250/1000/3000; indentation concrete D 150 at t 15/20/25 and D 160 at t 20
+#: linear S 25/51/100 at p 6.4 and p 1.9/6.4/7.6 at S 100; ODC no oscillation, nu < 1 at 45/60/67.5 rev/s,
+#: nu = 3.5 and the supplementary nu > 1 series at 45/60/67.5 rev/s; rotary r 250/1000/3000; indentation concrete D 150 at t 15/20/25 and D 160 at t 20
 TREND_SUBSETS: dict[str, tuple[str, ...]] = {
     "linear_ccs": ("lin_red_s25_p6p4", "lin_red_s51_p6p4", "lin_red_s100_p6p4", "lin_red_s100_p1p9", "lin_red_s100_p7p6"),
-    "odc": ("odc_red_s10", "odc_red_s12", "odc_red_s13", "odc_red_s14", "odc_red_s16"),
+    "odc": ("odc_red_s10", "odc_red_s12", "odc_red_s13", "odc_red_s14", "odc_red_s16", "odc_red_s101", "odc_red_s102",
+            "odc_red_s103"),
     "rotary": ("rot_red_r250", "rot_red_r1000", "rot_red_r3000"),
     "indentation_asymmetric": ("ind_red_concrete_d150_t15", "ind_red_concrete_d150_t20", "ind_red_concrete_d150_t25",
                                "ind_red_concrete_d160_t20"),
@@ -713,7 +722,8 @@ class Trend:
     ``x`` is a full-scale (seed-unit) factor column of index.csv, so reduced and full runs share the
     seed's x range ``x_range``; ``expect`` is the sign the seed reports (+1 rises, -1 falls);
     ``seed_change`` the seed's relative change of y over ``x_range`` (``seed_note`` says where it
-    comes from). The runs' change is taken over the same range."""
+    comes from). The runs' change is taken over the same range. ``expect`` 0: the seed reports no
+    trend; the runs agree when the slope is not significant at 5 %."""
 
     id: str
     text: str
@@ -770,6 +780,13 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
               only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
+        Trend("f_flat_with_freq_nu_gt_1", "no fall of the mean force with frequency when nu > 1 (no backward motion; "
+              "supplementary runs 101-103, at least half a cycle in the window)",
+              "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), 0, 0.0,
+              "seed 003 sec. 5.4.3: the force 'only decreases when backwards movement exist[s]'; without it (e/R 0.1, 0.2 "
+              "at 22.5 rev/s, nu 3.5, 1.8) the mean force is 735 and 754 N against 712 N without oscillation (taken as "
+              "no change)", x_range=(45, 67.5),
+              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
     ),
 }
 
@@ -797,7 +814,7 @@ def trend_table(family: str, table: "Any") -> "Any":
             t = t.query(tr.only)
         t = t.dropna(subset=[tr.x, tr.y])
         t = t.assign(_x=np.log(t[tr.x]) if tr.log_x else t[tr.x], _y=t[tr.y].abs() if tr.abs_y else t[tr.y])
-        t["_g"] = t[list(tr.groups)].astype(str).agg("|".join, axis=1) if tr.groups else "all"
+        t["_g"] = t[list(tr.groups)].astype(str).agg("|".join, axis=1) if tr.groups and len(t) else "all"
         usable = t.groupby("_g")["_x"].transform("nunique") >= 2
         t = t[usable]
         row = {"family": family, "trend": tr.id, "description": tr.text, "y": tr.y, "x": tr.x + (" (log)" if tr.log_x else ""),
@@ -828,7 +845,8 @@ def trend_table(family: str, table: "Any") -> "Any":
         extrapolated = bool(xs.min() > min(tr.x_range) * 1.001 or xs.max() < max(tr.x_range) * 0.999)
         rows.append({**row, "slope": slope, "p_value": pval, "change_1": float(np.nanmean(changes)),
                      "runs_x_min": float(xs.min()), "runs_x_max": float(xs.max()), "extrapolated": extrapolated,
-                     "sign_as_seed": bool(np.sign(slope) == tr.expect),
+                     "sign_as_seed": (bool(np.sign(slope) == tr.expect) if tr.expect else
+                                      (bool(pval >= 0.05) if pval == pval else None)),
                      "significant_5pct": (bool(pval < 0.05) if pval == pval else None)})
     cols = ["family", "trend", "description", "y", "x", "x_range_seed", "runs", "groups", "slope", "p_value", "change_1",
             "seed_change_1", "runs_x_min", "runs_x_max", "extrapolated", "sign_as_seed", "significant_5pct", "expected_sign",

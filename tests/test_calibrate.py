@@ -189,14 +189,21 @@ def test_clump_fields_in_params_keys_and_overrides():
     from deckgen.calibrate import CalibratedParams
 
     p = MicroParams(20.0, 60.0, 15.0, gap_tolerance=0.4, contact_modulus_ratio=4.0)
-    # without clumps the key is the one recorded before the clump fields existed
-    old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_")}
+    # without clumps (and at the defaults of the later fields) the key is the one recorded before they existed
+    later = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor")
+    old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_") and k not in later}
     assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
     assert "clump_size" not in p.overrides()["bonds"]
     q = MicroParams(20.0, 60.0, 15.0, clump_size=4, clump_strength_factor=50.0)
     assert q.key() != MicroParams(20.0, 60.0, 15.0).key()
     assert q.overrides()["bonds"]["clump_size"] == 4 and q.overrides()["bonds"]["clump_strength_factor"] == 50.0
     CalibratedParams(bonds={k: float(v) for k, v in q.overrides()["bonds"].items()})  # a valid card block
+    assert not set(later) & set(q.overrides()["bonds"])
+    u = MicroParams(20.0, 60.0, 15.0, unbonded_fraction=0.25, bending_strength_factor=10.0)
+    assert u.key() not in (MicroParams(20.0, 60.0, 15.0).key(), MicroParams(20.0, 60.0, 15.0, unbonded_fraction=0.25).key())
+    assert u.overrides()["bonds"]["unbonded_fraction"] == 0.25 and u.overrides()["bonds"]["bending_strength_factor"] == 10.0
+    assert "twisting_strength_factor" not in u.overrides()["bonds"]
+    CalibratedParams(bonds={k: float(v) for k, v in u.overrides()["bonds"].items()})
 
 
 def test_parameter_space_round_trip_and_bounds():

@@ -307,12 +307,16 @@ class MicroParams:
     clump_size: int = 1  # grains per clump (bonds.clump_size; 1 = no clumps)
     clump_strength_factor: float = 100.0  # intra-clump bond strengths / sigma_c, tau_c (with clumps)
     clump_stiffness_factor: float = 1.0  # intra-clump bond modulus / E_b (with clumps)
+    unbonded_fraction: float = 0.0  # bondable pairs left without a bond (bonds.unbonded_fraction)
+    bending_strength_factor: float = 1.0  # critical bending torque / parallel-bond value (bonds.*)
+    twisting_strength_factor: float = 1.0  # critical twisting torque / parallel-bond value (bonds.*)
 
     def key(self) -> str:
         """Hash of the values rounded to 10 significant digits (folder and table key).
 
-        ``gap_tolerance``, ``contact_modulus_ratio`` and the clump fields enter only when they differ
-        from their defaults, so points recorded before they were parameters keep their keys.
+        ``gap_tolerance``, ``contact_modulus_ratio``, the clump fields, ``unbonded_fraction`` and the
+        bending/twisting strength factors enter only when they differ from their defaults, so points
+        recorded before they were parameters keep their keys.
         """
         vals = {k: float(f"{v:.10g}") for k, v in asdict(self).items()}
         if vals["gap_tolerance"] == 0.05:
@@ -321,16 +325,25 @@ class MicroParams:
             del vals["contact_modulus_ratio"]
         if vals["clump_size"] == 1:
             del vals["clump_size"], vals["clump_strength_factor"], vals["clump_stiffness_factor"]
+        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
+                              ("twisting_strength_factor", 1.0)):
+            if vals[name] == default:
+                del vals[name]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
-        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1)."""
+        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1), the
+        unbonded fraction and bending/twisting strength factors only when not at their defaults."""
         bonds = {"youngs_modulus_GPa": self.youngs_modulus_GPa, "tensile_strength_MPa": self.tensile_strength_MPa,
                  "shear_strength_MPa": self.shear_strength_MPa, "radius_multiplier": self.radius_multiplier,
                  "gap_tolerance": self.gap_tolerance}
         if self.clump_size != 1:
             bonds.update(clump_size=int(self.clump_size), clump_strength_factor=self.clump_strength_factor,
                          clump_stiffness_factor=self.clump_stiffness_factor)
+        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
+                              ("twisting_strength_factor", 1.0)):
+            if getattr(self, name) != default:
+                bonds[name] = getattr(self, name)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

@@ -335,6 +335,32 @@ def test_cli_with_stand_in(tmp_path, capsys):
     assert load_card(out / "card.yaml").provenance.new_evaluations == 0
 
 
+def test_card_start_fixes_a_mechanism_the_tables_do_not_cover(tmp_path):
+    """calibration.start: clumps and a twisting factor held fixed (not optimiser parameters) reach the calibrated
+    card; sigma_c alone keeps the analytic start's tau_c/sigma_c; unknown fields are refused by name."""
+    import yaml
+
+    from deckgen.calibrate import run_card
+
+    d = yaml.safe_load((MATERIALS / "concrete.yaml").read_text())
+    d.setdefault("calibration", {})["start"] = {"clump_size": 16, "twisting_strength_factor": 10.0,
+                                                "tensile_strength_MPa": 7.0}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(d))
+    res = run_card(path, tmp_path / "out", stand_in=True, quiet=True)
+    card = load_card(tmp_path / "out" / "card.yaml")
+    assert card.calibrated.bonds["clump_size"] == 16 and card.calibrated.bonds["twisting_strength_factor"] == 10.0
+    assert card.provenance.start["clump_size"] == 16 and card.provenance.start["tensile_strength_MPa"] == 7.0
+    plain = run_card(MATERIALS / "concrete.yaml", tmp_path / "plain", stand_in=True, quiet=True)
+    r0 = plain.card.provenance.start["shear_strength_MPa"] / plain.card.provenance.start["tensile_strength_MPa"]
+    assert card.provenance.start["shear_strength_MPa"] == pytest.approx(7.0 * r0, rel=1e-5)
+    assert res.n_evals >= 1
+    d["calibration"]["start"] = {"clumps": 4}
+    path.write_text(yaml.safe_dump(d))
+    with pytest.raises(Exception, match=r"start: unknown field\(s\) \['clumps'\]"):
+        load_card(path)
+
+
 # ------------------------------------------------------------------------------------ one real DEM step
 def _lmp_ok() -> bool:
     from deckgen.runner import engine_available

@@ -142,9 +142,18 @@ class CalibrationSetup(_Model):
             "overriding the defaults of deckgen.calibrate.PARAMS."))
     ucs_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_UCS), description="UCS specimen block.")
     bts_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_BTS), description="BTS specimen block.")
+    start: dict[str, float] = Field(default_factory=dict, description=(
+        "Start point fields (deckgen.calibrate.MicroParams names, physical units) set over the analytic start, e.g. "
+        "{clump_size: 16, twisting_strength_factor: 10, youngs_modulus_GPa: 13}. Fields that are not optimiser "
+        "parameters keep these values throughout and go into the calibrated card (a mechanism the micro-macro "
+        "tables do not cover: set its measured start here)."))
 
     @model_validator(mode="after")
     def _cases_valid(self) -> "CalibrationSetup":
+        known = set(MicroParams.__dataclass_fields__)
+        unknown = sorted(set(self.start) - known)
+        if unknown:
+            raise ValueError(f"start: unknown field(s) {unknown} (fix: use {sorted(known)})")
         if len(set(self.parameters)) != len(self.parameters):
             raise ValueError("parameters: a name appears twice (list each parameter once)")
         for key in ("log_E_b", "log_sigma_c"):
@@ -1217,6 +1226,11 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
     base = card.case_overrides()
     start = analytic_start(card.targets, deep_merge(base, {"specimen": setup.ucs_specimen}), space,
                            table=setup.start_table)
+    if setup.start:
+        fixed = {k: (int(v) if k == "clump_size" else float(v)) for k, v in setup.start.items()}
+        if "tensile_strength_MPa" in fixed and "shear_strength_MPa" not in fixed:  # keep the start's tau_c/sigma_c
+            fixed["shear_strength_MPa"] = fixed["tensile_strength_MPa"] * start.tau_ratio
+        start = replace(start, **fixed)
     if stand_in:
         evaluator: Any = StandInEvaluator()
     else:

@@ -92,6 +92,17 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("bending strength x0.3", {"bending_strength_factor": 0.3}),
     ("twisting strength x10", {"twisting_strength_factor": 10.0}),
     ("unbonded 0.5, clumps of 16", {"unbonded_fraction": 0.5, "clump_size": 16}),
+    # the torque factors that raised UCS/BTS (bending x0.3) and M (twisting x10), together and with clumps
+    ("bending x0.3 and twisting x10", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0}),
+    ("twisting x10, clumps of 16", {"twisting_strength_factor": 10.0, "clump_size": 16}),
+    ("bending x0.1 and twisting x100", {"bending_strength_factor": 0.1, "twisting_strength_factor": 100.0}),
+    ("bending x0.3 and twisting x10, clumps of 16", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0,
+                                                      "clump_size": 16}),
+    ("bending x0.3 and twisting x10, tau/sigma=0.5", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0,
+                                                       "shear_strength_MPa": 30.0}),
+    ("twisting x100, clumps of 16", {"twisting_strength_factor": 100.0, "clump_size": 16}),
+    ("twisting x10 + clumps of 16 + tau/sigma=0.5", {"twisting_strength_factor": 10.0, "clump_size": 16,
+                                                    "shear_strength_MPa": 30.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
@@ -404,7 +415,7 @@ def main(argv: list[str] | None = None) -> int:
                 card = load_card(a.card)
                 base = card.case_overrides()
                 ucs, bts = quasi_static_specimens(card)
-            only = [o.strip() for o in a.only.split(",")] if a.only else None
+            only = [o.strip() for o in a.only.split(",") if o.strip()] if a.only else None  # "a,": no empty prefix (it matches all)
             ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}
             bts = bts or {**DEFAULT_BTS, "platen_speed_m_s": 0.1}
             if a.ucs_stop is not None:

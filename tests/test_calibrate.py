@@ -189,14 +189,21 @@ def test_clump_fields_in_params_keys_and_overrides():
     from deckgen.calibrate import CalibratedParams
 
     p = MicroParams(20.0, 60.0, 15.0, gap_tolerance=0.4, contact_modulus_ratio=4.0)
-    # without clumps the key is the one recorded before the clump fields existed
-    old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_")}
+    # without clumps (and at the defaults of the later fields) the key is the one recorded before they existed
+    later = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor")
+    old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_") and k not in later}
     assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
     assert "clump_size" not in p.overrides()["bonds"]
     q = MicroParams(20.0, 60.0, 15.0, clump_size=4, clump_strength_factor=50.0)
     assert q.key() != MicroParams(20.0, 60.0, 15.0).key()
     assert q.overrides()["bonds"]["clump_size"] == 4 and q.overrides()["bonds"]["clump_strength_factor"] == 50.0
     CalibratedParams(bonds={k: float(v) for k, v in q.overrides()["bonds"].items()})  # a valid card block
+    assert not set(later) & set(q.overrides()["bonds"])
+    u = MicroParams(20.0, 60.0, 15.0, unbonded_fraction=0.25, bending_strength_factor=10.0)
+    assert u.key() not in (MicroParams(20.0, 60.0, 15.0).key(), MicroParams(20.0, 60.0, 15.0, unbonded_fraction=0.25).key())
+    assert u.overrides()["bonds"]["unbonded_fraction"] == 0.25 and u.overrides()["bonds"]["bending_strength_factor"] == 10.0
+    assert "twisting_strength_factor" not in u.overrides()["bonds"]
+    CalibratedParams(bonds={k: float(v) for k, v in u.overrides()["bonds"].items()})
 
 
 def test_parameter_space_round_trip_and_bounds():
@@ -326,6 +333,32 @@ def test_cli_with_stand_in(tmp_path, capsys):
     # resumable: a second call replays the table
     assert main([str(MATERIALS / "concrete.yaml"), "--out", str(out), "--stand-in"]) == 0
     assert load_card(out / "card.yaml").provenance.new_evaluations == 0
+
+
+def test_card_start_fixes_a_mechanism_the_tables_do_not_cover(tmp_path):
+    """calibration.start: clumps and a twisting factor held fixed (not optimiser parameters) reach the calibrated
+    card; sigma_c alone keeps the analytic start's tau_c/sigma_c; unknown fields are refused by name."""
+    import yaml
+
+    from deckgen.calibrate import run_card
+
+    d = yaml.safe_load((MATERIALS / "concrete.yaml").read_text())
+    d.setdefault("calibration", {})["start"] = {"clump_size": 16, "twisting_strength_factor": 10.0,
+                                                "tensile_strength_MPa": 7.0}
+    path = tmp_path / "c.yaml"
+    path.write_text(yaml.safe_dump(d))
+    res = run_card(path, tmp_path / "out", stand_in=True, quiet=True)
+    card = load_card(tmp_path / "out" / "card.yaml")
+    assert card.calibrated.bonds["clump_size"] == 16 and card.calibrated.bonds["twisting_strength_factor"] == 10.0
+    assert card.provenance.start["clump_size"] == 16 and card.provenance.start["tensile_strength_MPa"] == 7.0
+    plain = run_card(MATERIALS / "concrete.yaml", tmp_path / "plain", stand_in=True, quiet=True)
+    r0 = plain.card.provenance.start["shear_strength_MPa"] / plain.card.provenance.start["tensile_strength_MPa"]
+    assert card.provenance.start["shear_strength_MPa"] == pytest.approx(7.0 * r0, rel=1e-5)
+    assert res.n_evals >= 1
+    d["calibration"]["start"] = {"clumps": 4}
+    path.write_text(yaml.safe_dump(d))
+    with pytest.raises(Exception, match=r"start: unknown field\(s\) \['clumps'\]"):
+        load_card(path)
 
 
 # ------------------------------------------------------------------------------------ one real DEM step

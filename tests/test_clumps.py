@@ -205,8 +205,14 @@ def test_clumps_in_the_rendered_specimen(tmp_path):
     ({"clump_strength_factor": 0.5}, "greater than or equal to 1"),
     ({"clump_stiffness_factor": 0}, "greater than or equal to 0.1"),
     ({"clump_size": 3, "enabled": False}, "clumps are made of bonds"),
+    ({"unbonded_fraction": -0.1}, "greater than or equal to 0"),
+    ({"unbonded_fraction": 0.95}, "less than or equal to 0.9"),
+    ({"unbonded_fraction": 0.3, "enabled": False}, "no bond to leave out"),
+    ({"bending_strength_factor": 0.0}, "greater than or equal to 0.1"),
+    ({"twisting_strength_factor": "x"}, "valid number"),
 ])
-def test_clump_fields_are_validated(tmp_path, bonds, words):
+def test_bond_fields_are_validated(tmp_path, bonds, words):
+    """Clump fields here, and the unbonded fraction and torque strength factors of tests/test_unbonded.py."""
     p = tmp_path / "c.yaml"
     p.write_text(json.dumps({"bonds": bonds}))
     with pytest.raises(SpecError) as err:

@@ -92,11 +92,14 @@ def bpm_coefficients(
     m_eff: np.ndarray | float,
     I_eff: np.ndarray | float,
     damping_ratio: float,
+    bending_factor: float = 1.0,
+    twisting_factor: float = 1.0,
 ) -> dict[str, np.ndarray]:
     """The 12 bpm/rotational coefficients (SI) for bonds of radius ``r_bond`` and length ``length``.
 
     E_b [Pa], sigma_c, tau_c [Pa], r_bond, length [m], m_eff [kg], I_eff [kg m^2].
-    Arrays broadcast; see the module docstring for the derivation.
+    Arrays broadcast; see the module docstring for the derivation. ``bending_factor`` and
+    ``twisting_factor`` multiply the critical bending and twisting torques (1: the parallel-bond match).
     """
     A, I, J = section(r_bond)
     L = np.asarray(length, dtype=float)
@@ -114,8 +117,8 @@ def bpm_coefficients(
         "k_b": k_b,
         "F_rc": sigma_c * A,
         "F_sc": tau_c * A,
-        "tau_bc": sigma_c * I / rb,
-        "tau_tc": tau_c * J / rb,
+        "tau_bc": bending_factor * sigma_c * I / rb,
+        "tau_tc": twisting_factor * tau_c * J / rb,
         "gamma_n": 2.0 * damping_ratio * np.sqrt(m_eff * k_r),
         "gamma_s": 2.0 * damping_ratio * np.sqrt(m_eff * k_s),
         "gamma_r": 4.0 * damping_ratio * np.sqrt(I_eff * k_b) / L,
@@ -195,6 +198,24 @@ def grow_clumps(pairs: np.ndarray, n: int, clump_size: int, seed: int, x: np.nda
     return label
 
 
+def unbonded_mask(n_pairs: int, fraction: float, seed: int, protect: np.ndarray | None = None) -> np.ndarray:
+    """Mask of the bondable pairs left without a bond: ``round(fraction * n_eligible)`` of them.
+
+    Eligible are the pairs not marked in ``protect`` (intra-clump bonds stay). The choice is a
+    uniform draw without replacement from a generator seeded with ``seed`` (the packing seed), offset
+    so it does not repeat the clump-growing order drawn from the same seed. Deterministic.
+    """
+    if not 0.0 <= fraction < 1.0:
+        raise ValueError(f"unbonded fraction must be in [0, 1), got {fraction}")
+    drop = np.zeros(n_pairs, dtype=bool)
+    eligible = np.arange(n_pairs) if protect is None else np.flatnonzero(~np.asarray(protect, dtype=bool))
+    k = int(round(fraction * len(eligible)))
+    if k:
+        pick = np.random.default_rng([int(seed), 0x5EED]).choice(eligible, size=k, replace=False)
+        drop[pick] = True
+    return drop
+
+
 def clump_sizes(label: np.ndarray) -> dict[int, int]:
     """Clump-size distribution: {size: number of clumps of that size}."""
     if len(label) == 0:
@@ -262,6 +283,8 @@ def make_bond_table(
     intra: np.ndarray | None = None,
     clump_strength_factor: float = 1.0,
     clump_stiffness_factor: float = 1.0,
+    bending_factor: float = 1.0,
+    twisting_factor: float = 1.0,
 ) -> BondTable:
     """Bin bonds by (bond radius, bond length) into types and compute per-type coefficients.
 
@@ -300,7 +323,8 @@ def make_bond_table(
 
         rb_t, L_t = mean(rb), mean(L)
         parts.append((rb_t, L_t, bpm_coefficients(E_b * e_f, stiffness_ratio, sigma_c * s_f, tau_c * s_f, rb_t, L_t,
-                                                   mean(m_eff), mean(I_eff), damping_ratio)))
+                                                   mean(m_eff), mean(I_eff), damping_ratio,
+                                                   bending_factor=bending_factor, twisting_factor=twisting_factor)))
         types[sel] = types0 + 1 + offset
         offset += nt
     n_plain = len(parts[0][0]) if parts and (~mask).any() else 0

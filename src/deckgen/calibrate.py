@@ -142,9 +142,18 @@ class CalibrationSetup(_Model):
             "overriding the defaults of deckgen.calibrate.PARAMS."))
     ucs_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_UCS), description="UCS specimen block.")
     bts_specimen: dict[str, Any] = Field(default_factory=lambda: dict(DEFAULT_BTS), description="BTS specimen block.")
+    start: dict[str, float] = Field(default_factory=dict, description=(
+        "Start point fields (deckgen.calibrate.MicroParams names, physical units) set over the analytic start, e.g. "
+        "{clump_size: 16, twisting_strength_factor: 10, youngs_modulus_GPa: 13}. Fields that are not optimiser "
+        "parameters keep these values throughout and go into the calibrated card (a mechanism the micro-macro "
+        "tables do not cover: set its measured start here)."))
 
     @model_validator(mode="after")
     def _cases_valid(self) -> "CalibrationSetup":
+        known = set(MicroParams.__dataclass_fields__)
+        unknown = sorted(set(self.start) - known)
+        if unknown:
+            raise ValueError(f"start: unknown field(s) {unknown} (fix: use {sorted(known)})")
         if len(set(self.parameters)) != len(self.parameters):
             raise ValueError("parameters: a name appears twice (list each parameter once)")
         for key in ("log_E_b", "log_sigma_c"):
@@ -307,12 +316,16 @@ class MicroParams:
     clump_size: int = 1  # grains per clump (bonds.clump_size; 1 = no clumps)
     clump_strength_factor: float = 100.0  # intra-clump bond strengths / sigma_c, tau_c (with clumps)
     clump_stiffness_factor: float = 1.0  # intra-clump bond modulus / E_b (with clumps)
+    unbonded_fraction: float = 0.0  # bondable pairs left without a bond (bonds.unbonded_fraction)
+    bending_strength_factor: float = 1.0  # critical bending torque / parallel-bond value (bonds.*)
+    twisting_strength_factor: float = 1.0  # critical twisting torque / parallel-bond value (bonds.*)
 
     def key(self) -> str:
         """Hash of the values rounded to 10 significant digits (folder and table key).
 
-        ``gap_tolerance``, ``contact_modulus_ratio`` and the clump fields enter only when they differ
-        from their defaults, so points recorded before they were parameters keep their keys.
+        ``gap_tolerance``, ``contact_modulus_ratio``, the clump fields, ``unbonded_fraction`` and the
+        bending/twisting strength factors enter only when they differ from their defaults, so points
+        recorded before they were parameters keep their keys.
         """
         vals = {k: float(f"{v:.10g}") for k, v in asdict(self).items()}
         if vals["gap_tolerance"] == 0.05:
@@ -321,16 +334,25 @@ class MicroParams:
             del vals["contact_modulus_ratio"]
         if vals["clump_size"] == 1:
             del vals["clump_size"], vals["clump_strength_factor"], vals["clump_stiffness_factor"]
+        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
+                              ("twisting_strength_factor", 1.0)):
+            if vals[name] == default:
+                del vals[name]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
-        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1)."""
+        """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1), the
+        unbonded fraction and bending/twisting strength factors only when not at their defaults."""
         bonds = {"youngs_modulus_GPa": self.youngs_modulus_GPa, "tensile_strength_MPa": self.tensile_strength_MPa,
                  "shear_strength_MPa": self.shear_strength_MPa, "radius_multiplier": self.radius_multiplier,
                  "gap_tolerance": self.gap_tolerance}
         if self.clump_size != 1:
             bonds.update(clump_size=int(self.clump_size), clump_strength_factor=self.clump_strength_factor,
                          clump_stiffness_factor=self.clump_stiffness_factor)
+        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
+                              ("twisting_strength_factor", 1.0)):
+            if getattr(self, name) != default:
+                bonds[name] = getattr(self, name)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa
@@ -1204,6 +1226,11 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
     base = card.case_overrides()
     start = analytic_start(card.targets, deep_merge(base, {"specimen": setup.ucs_specimen}), space,
                            table=setup.start_table)
+    if setup.start:
+        fixed = {k: (int(v) if k == "clump_size" else float(v)) for k, v in setup.start.items()}
+        if "tensile_strength_MPa" in fixed and "shear_strength_MPa" not in fixed:  # keep the start's tau_c/sigma_c
+            fixed["shear_strength_MPa"] = fixed["tensile_strength_MPa"] * start.tau_ratio
+        start = replace(start, **fixed)
     if stand_in:
         evaluator: Any = StandInEvaluator()
     else:

@@ -82,6 +82,27 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("tau/sigma=0.1 at tau_c/E_b 3e-3 (sigma_c 600)", {"tensile_strength_MPa": 600.0}),
     # the two that raise M = (UCS/BTS)(UCS/E) most, together
     ("clumps of 16, sigma_c 600 (tau/sigma=0.1)", {"clump_size": 16, "tensile_strength_MPa": 600.0}),
+    # closed cohesionless contacts (Schoepfer et al. 2009 "crack density"): tension loses the missing bonds,
+    # compression keeps them as frictional contacts
+    ("unbonded 0.25", {"unbonded_fraction": 0.25}),
+    ("unbonded 0.5", {"unbonded_fraction": 0.5}),
+    ("unbonded 0.75", {"unbonded_fraction": 0.75}),
+    # bending and twisting strengths set apart from sigma_c and tau_c
+    ("bending strength x10", {"bending_strength_factor": 10.0}),
+    ("bending strength x0.3", {"bending_strength_factor": 0.3}),
+    ("twisting strength x10", {"twisting_strength_factor": 10.0}),
+    ("unbonded 0.5, clumps of 16", {"unbonded_fraction": 0.5, "clump_size": 16}),
+    # the torque factors that raised UCS/BTS (bending x0.3) and M (twisting x10), together and with clumps
+    ("bending x0.3 and twisting x10", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0}),
+    ("twisting x10, clumps of 16", {"twisting_strength_factor": 10.0, "clump_size": 16}),
+    ("bending x0.1 and twisting x100", {"bending_strength_factor": 0.1, "twisting_strength_factor": 100.0}),
+    ("bending x0.3 and twisting x10, clumps of 16", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0,
+                                                      "clump_size": 16}),
+    ("bending x0.3 and twisting x10, tau/sigma=0.5", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0,
+                                                       "shear_strength_MPa": 30.0}),
+    ("twisting x100, clumps of 16", {"twisting_strength_factor": 100.0, "clump_size": 16}),
+    ("twisting x10 + clumps of 16 + tau/sigma=0.5", {"twisting_strength_factor": 10.0, "clump_size": 16,
+                                                    "shear_strength_MPa": 30.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
@@ -248,7 +269,10 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
                     gap_tolerance=b.get("gap_tolerance", 0.05),
                     contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
                     clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
-                    clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0))
+                    clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
+                    unbonded_fraction=b.get("unbonded_fraction", 0.0),
+                    bending_strength_factor=b.get("bending_strength_factor", 1.0),
+                    twisting_strength_factor=b.get("twisting_strength_factor", 1.0))
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 
@@ -391,7 +415,7 @@ def main(argv: list[str] | None = None) -> int:
                 card = load_card(a.card)
                 base = card.case_overrides()
                 ucs, bts = quasi_static_specimens(card)
-            only = [o.strip() for o in a.only.split(",")] if a.only else None
+            only = [o.strip() for o in a.only.split(",") if o.strip()] if a.only else None  # "a,": no empty prefix (it matches all)
             ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}
             bts = bts or {**DEFAULT_BTS, "platen_speed_m_s": 0.1}
             if a.ucs_stop is not None:

@@ -26,6 +26,7 @@ from deckgen.bonds import (
     intra_clump,
     make_bond_table,
     stable_timestep,
+    unbonded_mask,
 )
 from deckgen.datafile import write_bpm_data
 from deckgen.packing import ensure_packing, load_packing, specimen_region
@@ -356,12 +357,20 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     if b.clump_size > 1 and b.enabled:  # clumps grown on the bond graph from the packing seed
         clumps = grow_clumps(pairs, len(r_full), b.clump_size, seed=case.packing.seed, x=atoms.x)
         intra = intra_clump(pairs, clumps)
+    n_unbonded = 0
+    if b.unbonded_fraction > 0 and b.enabled:  # closed cohesionless contacts ("cracks"), from the packing seed
+        drop = unbonded_mask(len(pairs), b.unbonded_fraction, seed=case.packing.seed, protect=intra)
+        n_unbonded = int(drop.sum())
+        pairs = pairs[~drop]
+        if intra is not None:
+            intra = intra[~drop]
     table = make_bond_table(
         atoms.x, r, mass, pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
         sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
         radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
         bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
-        intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor)
+        intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor,
+        bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
@@ -419,6 +428,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     }
     if not b.enabled:
         derived["bonded"] = False
+    if n_unbonded:
+        derived["unbonded"] = {"fraction": b.unbonded_fraction, "unbonded_pairs": n_unbonded,
+                               "bondable_pairs": n_unbonded + int(len(pairs))}
     if clumps is not None and intra is not None:
         dist = clump_sizes(clumps)
         multi = {k: v for k, v in dist.items() if k > 1}

@@ -89,6 +89,13 @@ class Packing(_Model):
 
 
 # --------------------------------------------------------------------------- bonds
+def _torque_factor(kind: str, formula: str, meaning_of_1: str) -> Any:
+    """A bond torque-strength factor field (default 1, left out of spec.json at 1)."""
+    return Field(1.0, ge=0.1, le=1e6, exclude_if=lambda v: v == 1.0, json_schema_extra={"unit": "1"},
+                 description=f"Critical {kind} torque of a bond = factor x {formula} (1: {meaning_of_1}). "
+                 "Written to spec.json only when not 1.")
+
+
 class Bonds(_Model):
     """Parallel-bond inputs (Potyondy & Cundall 2004 style; seed 000 eqs. 7-16), mapped to the
     12 coefficients of LAMMPS ``bond_style bpm/rotational`` by :mod:`deckgen.bonds`."""
@@ -121,6 +128,17 @@ class Bonds(_Model):
         1.0, "1", "Intra-clump bonds: Young's modulus is this many times E_b (> 1 stiffens the clumps and shortens the "
         "time step). Used only with clump_size > 1.", ge=0.1, le=100,
     )
+    unbonded_fraction: float = Field(
+        0.0, ge=0, le=0.9, exclude_if=lambda v: v == 0.0,
+        description="Fraction of the bondable grain pairs left without a bond: closed, cohesionless contacts "
+        "(the 'crack density' of Schoepfer, Abe, Childs & Walsh 2009, IJRMMS 46:250-261), drawn from the packing "
+        "seed; intra-clump bonds are never dropped. Written to spec.json only when > 0.",
+        json_schema_extra={"unit": "1"},
+    )
+    bending_strength_factor: float = _torque_factor(
+        "bending", "sigma_c I / r_b", "a parallel bond's tension check; large: bending does not break bonds, like a "
+        "zero moment-contribution factor in PFC")
+    twisting_strength_factor: float = _torque_factor("twisting", "tau_c J / r_b", "a parallel bond's shear check")
     enabled: bool = Field(
         True, description="False: an unbonded granular specimen (the same packing and radius shrink, no bond; "
         "cross-engine checks). Written to spec.json only when false.",
@@ -132,6 +150,9 @@ class Bonds(_Model):
         if self.clump_size > 1 and not self.enabled:
             raise ValueError("clump_size: clumps are made of bonds; an unbonded specimen (enabled: false) has none "
                              "(fix: clump_size: 1, or enabled: true)")
+        if self.unbonded_fraction > 0 and not self.enabled:
+            raise ValueError("unbonded_fraction: an unbonded specimen (enabled: false) has no bond to leave out "
+                             "(fix: unbonded_fraction: 0, or enabled: true)")
         return self
 
 

@@ -272,3 +272,79 @@ def test_dem_switches_change_the_deck(tmp_path):
     n = int(next(ln for ln in deck1.splitlines() if ln.startswith("# confining stress")).split(": ")[1].split()[0])
     f = float(lines[0].split()[5])
     assert n * f == pytest.approx(-4.0e6 * 16e-3 * 8e-3, rel=1e-6)
+
+
+# --------------------------------------------------------------------------- packing-seed replicates in the backend
+class _NoisyDem:
+    """A stand-in for the dem backend's runs: the fast model times a packing-seed factor 1 + 0.3 z, where z
+    depends on the packing seed and the cut depth only (the same packing gives the same chips whatever
+    the switches: common random numbers, as in the real backend)."""
+
+    def __init__(self) -> None:
+        self.calls: list[int] = []
+
+    def __call__(self, flat: dict) -> dict:
+        self.calls.append(int(flat["packing.seed"]))
+        rng = np.random.default_rng([int(flat["packing.seed"]), int(round(1000 * flat["kinematics.penetration_mm"]))])
+        f = 1.0 + 0.3 * float(rng.standard_normal())
+        return {k: f * v for k, v in predict_row(flat).items()}
+
+
+def _noisy_backend(tmp_path, seeds):
+    from deckgen.gap.backends import DemBackend
+
+    be = DemBackend(tmp_path / "runs", seeds=seeds)
+    be.run_one = _NoisyDem()  # type: ignore[method-assign]
+    return be
+
+
+def test_dem_backend_averages_over_packing_seeds(tmp_path):
+    from deckgen.gap.backends import make_backend
+    from deckgen.gap.data import GapInputError, RESPONSE_COLUMNS
+
+    flat = flat_case(load_case(BASE))
+    cases = pd.DataFrame([dict(flat, **{"kinematics.penetration_mm": p}) for p in (1.0, 2.0)])
+    be = _noisy_backend(tmp_path, [11, 22, 33])
+    out = be.simulate(cases)
+    assert be.run_one.calls == [11, 22, 33, 11, 22, 33]
+    one = _NoisyDem()
+    for i, p in enumerate((1.0, 2.0)):
+        ys = pd.DataFrame([one(dict(flat, **{"kinematics.penetration_mm": p, "packing.seed": s})) for s in (11, 22, 33)])
+        for r in RESPONSE_COLUMNS:
+            assert out.loc[i, r] == pytest.approx(ys[r].mean(), rel=1e-12)
+            assert be.last_se.loc[i, r] == pytest.approx(ys[r].std(ddof=1) / math.sqrt(3), rel=1e-12)
+    assert be.last_se["force_normal_N_mean_steady"].gt(0).all()
+    with pytest.raises(GapInputError, match="at least two seeds"):
+        make_backend("dem", tmp_path, seeds=[5])
+    with pytest.raises(GapInputError, match="the fast backend has no packing"):
+        make_backend("fast", tmp_path, seeds=[5, 6])
+
+
+def test_model_seed_scatter_keeps_a_noisy_model_from_naming_an_effect(tmp_path):
+    """No effect hidden, measured data tight (the fast model + 5 % scatter): a model whose 3-seed means scatter
+    by 0.3/sqrt(3) = 17 % misses them far beyond the measured noise. Counting its standard error the loop
+    calls the gap noise; ignoring it (last_se dropped), it does not."""
+    from deckgen.gap.data import read_measured
+    from deckgen.gap.loop import run_gap
+
+    mp, bp = _write_measured(tmp_path, "none", 4)
+    m = read_measured(mp, bp)
+    with_se = run_gap(m, _noisy_backend(tmp_path, [11, 22, 33]))
+    assert with_se["verdict"] == "within_noise" and with_se["named_effect"] is None
+    nz = with_se["noise"]
+    assert nz["backend_packing_seeds"] == [11, 22, 33]
+    for r in ("force_normal_N_mean_steady", "force_rolling_N_mean_steady"):  # no side force in a straight cut
+        assert nz["sigma_with_model_N"][r] > 2 * nz["sigma_N"][r], (r, nz)
+
+    class _NoSE:
+        """The same runs with the seed scatter withheld from the loop."""
+
+        def __init__(self, be):
+            self.be, self.default_cv, self.grid_points, self.name = be, be.default_cv, be.grid_points, "dem"
+
+        def simulate(self, cases):
+            return self.be.simulate(cases)
+
+    without = run_gap(m, _NoSE(_noisy_backend(tmp_path, [11, 22, 33])))
+    assert without["verdict"] != "within_noise"
+    assert without["gap_test"]["chi2"] > 3 * with_se["gap_test"]["chi2"]

@@ -185,8 +185,15 @@ def cmd_gap(args: argparse.Namespace) -> int:
     cands = [c.strip() for c in args.candidates.split(",") if c.strip()] if args.candidates else None
     if args.noise_cv is not None and not (0 < args.noise_cv < 1):
         raise SpecError(f"--noise-cv {args.noise_cv:g}: must lie in (0, 1) (fix: e.g. 0.05 for 5 % scatter)")
+    seeds = None
+    if args.packing_seeds:
+        try:
+            seeds = [int(v) for v in args.packing_seeds.split(",") if v.strip()]
+        except ValueError:
+            raise SpecError(f"--packing-seeds {args.packing_seeds!r}: not a list of integers (fix: e.g. 12345,202,303)") from None
     rep = gap(args.measured, args.base, args.out, backend=args.backend, candidates=cands, noise_cv=args.noise_cv,
-              command=_command(args), cache=_cache(args), runs=Path(args.runs) if args.runs else None)
+              command=_command(args), cache=_cache(args), runs=Path(args.runs) if args.runs else None,
+              packing_seeds=seeds)
     print(f"{args.measured}: {rep['cases']} cases, {rep['rows']} rows, backend {rep['backend']}: "
           f"named effect {rep['named_effect'] or 'none'} ({rep['verdict']})")
     print(f"  {rep['reason']}")
@@ -258,6 +265,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--candidates", help="comma-separated catalogue ids to consider (default: all)")
     s.add_argument("--noise-cv", type=float, help="relative scatter to assume when there are no replicates")
     s.add_argument("--runs", help="dem backend: folder of the (cached) runs (default: OUT/dem_runs)")
+    s.add_argument("--packing-seeds", help="dem backend: run every case on these packing seeds (comma-separated, "
+                   ">= 2) and compare their mean; their standard error joins the noise")
     engine_opts(s)
     s.set_defaults(func=cmd_gap)
     return p

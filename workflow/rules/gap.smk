@@ -2,7 +2,8 @@
 #   snakemake results/gap/<name>/report.json   for a study listed under `gap:` in the config
 #       (gap: {<name>: {measured: CSV, base: CASE, backend: fast|dem}})
 #   snakemake results/gap/seed002_demo/report.json   real data: seed 002 RCM forces vs a linear model
-#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc (slow)
+#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc (slow; 3 packing
+#       seeds for the measured rows and 3 others for every model case)
 # Engine jobs use one rank (gap_ranks, default 1).
 
 GAP = config.get("gap", {})
@@ -46,7 +47,7 @@ rule gap_dem_measured:
     shell:
         "python -m deckgen.gap.examples dem-measured --base {input.base} --out {output.csv} "
         "--runs {params.runs} --cache {params.cache} --set kinematics.spin=rolling "
-        "--penetrations 1.0,1.5,2.0 --seeds 101 --ranks {threads} > {log} 2>&1"
+        "--penetrations 1.0,1.5,2.0 --seeds 101,404,505 --ranks {threads} > {log} 2>&1"
 
 
 rule gap_dem_example:
@@ -68,7 +69,8 @@ rule gap_dem_example:
         cache=f"{RESULTS}/.cache",
     shell:
         "deckgen gap --measured {input.measured} --base {input.base} --out {params.out} --backend dem "
-        "--candidates free_rolling --noise-cv 0.1 --runs {params.runs} --ranks {threads} --cache {params.cache} "
+        "--candidates free_rolling --packing-seeds 12345,202,303 --runs {params.runs} --ranks {threads} "
+        "--cache {params.cache} "
         "> {log} 2>&1"
 
 

@@ -45,12 +45,18 @@ class DemBackend:
     default_cv = 0.05
 
     def __init__(self, runs_dir: str | Path, *, command: list[str] | None = None, cache: Path | None = None,
-                 progress: bool = False) -> None:
+                 progress: bool = False, seeds: list[int] | None = None) -> None:
         self.runs_dir = Path(runs_dir)
         self.command = command
         self.cache = cache
         self.progress = progress
         self.log: list[dict] = []
+        #: packing seeds each case is run on (mean reported); None: the case's own packing only
+        self.seeds = list(seeds) if seeds else None
+        if self.seeds is not None and len(self.seeds) < 2:
+            raise GapInputError("--packing-seeds: give at least two seeds (the scatter between them is the model's noise)")
+        #: standard error of each simulated mean over the seeds (set by :meth:`simulate` when seeds are given)
+        self.last_se: pd.DataFrame | None = None
 
     def run_one(self, flat: dict) -> dict:
         from deckgen.deck import render_case
@@ -73,15 +79,32 @@ class DemBackend:
         self.log.append({"run": run_dir.name, "n_grains": summary.get("n_grains"), "wall_s": summary.get("wall_s")})
         return {r: (np.nan if summary.get(r) is None else float(summary[r])) for r in RESPONSE_COLUMNS}
 
+    def run_seeds(self, flat: dict) -> tuple[dict, dict]:
+        """Mean and standard error of the responses of ``flat`` over :attr:`seeds` (common to every case,
+        so base and candidate runs share their packings and the packing scatter partly cancels in their
+        difference)."""
+        ys = pd.DataFrame([self.run_one(dict(flat, **{"packing.seed": int(s)})) for s in self.seeds or []],
+                          columns=list(RESPONSE_COLUMNS))
+        return ys.mean().to_dict(), (ys.std(ddof=1) / np.sqrt(len(ys))).to_dict()
+
     def simulate(self, cases: pd.DataFrame) -> pd.DataFrame:
-        rows = [self.run_one(r) for r in cases.to_dict("records")]
+        recs = cases.to_dict("records")
+        if self.seeds is None:
+            self.last_se = None
+            rows = [self.run_one(r) for r in recs]
+        else:
+            pairs = [self.run_seeds(r) for r in recs]
+            rows = [p[0] for p in pairs]
+            self.last_se = pd.DataFrame([p[1] for p in pairs], index=cases.index, columns=list(RESPONSE_COLUMNS))
         return pd.DataFrame(rows, index=cases.index, columns=list(RESPONSE_COLUMNS))
 
 
 def make_backend(name: str, out: Path, *, command: list[str] | None = None, cache: Path | None = None,
-                 runs: Path | None = None):
+                 runs: Path | None = None, seeds: list[int] | None = None):
     if name == "fast":
+        if seeds:
+            raise GapInputError("--packing-seeds: the fast backend has no packing (fix: drop it, or use --backend dem)")
         return FastBackend()
     if name == "dem":
-        return DemBackend(runs or out / "dem_runs", command=command, cache=cache)
+        return DemBackend(runs or out / "dem_runs", command=command, cache=cache, seeds=seeds)
     raise GapInputError(f"--backend {name}: unknown backend (fix: use fast or dem)")

@@ -6,7 +6,9 @@ Statistics (all on case means, weighted by replicates / noise variance; ``docs/d
   (``replicate`` rows, or rows with equal factors), with nu = sum(n_i - 1) degrees of freedom;
   without replicates, an assumed relative scatter (the backend's packing-seed scatter, or
   ``noise_cv``) of each response, at least of half the largest response (a side force near zero
-  scatters with the cutting forces), nu = infinity.
+  scatters with the cutting forces), nu = infinity. A backend that averages each case over several
+  packing seeds (``dem`` with ``--packing-seeds``) reports the standard error of its means; its
+  mean square joins each response's variance (sigma^2 + mean_i n_i SE_i^2), with nu unchanged.
 * **Find.** X0 = sum_ij n_i (y_ij - m_ij)^2 / s_j^2 over the M = cases x responses cells; the gap
   is *within noise* when X0 / M is not significant against F(M, nu) (chi2(M) when nu is infinite)
   at ``alpha_gap``. Per cell z-scores; per response and factor a weighted least-squares fit of the
@@ -259,7 +261,6 @@ def run_gap(measured: Measured, backend: Any, *, candidates: list[str] | None = 
     scale_floor = 1e-6 * max(float(np.abs(Y).max()), 1e-12)
     sigma = np.maximum(sigma, scale_floor)
     noise["sigma_N"] = {r: float(s) for r, s in zip(responses, sigma)}
-    W = n[:, None] / sigma[None, :] ** 2
     allr = np.ones(m, bool)
     M = m * J
 
@@ -271,6 +272,16 @@ def run_gap(measured: Measured, backend: Any, *, candidates: list[str] | None = 
     B = backend.simulate(cases)[responses].to_numpy(float)
     if not np.isfinite(B).all():
         raise GapInputError("backend: the base model gave no value for some case (see the runs)")
+    model_se = getattr(backend, "last_se", None)  # a backend averaging over packing seeds: its own noise
+    if model_se is not None and len(model_se) == m:
+        S = model_se[responses].to_numpy(float)
+        # the model mean's variance joins the measured one: n_i/sigma_eff^2 = 1/(sigma^2/n_i + S_i^2), pooled
+        # per response (sigma_eff^2 = sigma^2 + mean_i n_i S_i^2), so every statistic below sees both
+        sigma = np.sqrt(sigma**2 + np.mean(n[:, None] * S**2, axis=0))
+        noise["model_se_N"] = {r: float(v) for r, v in zip(responses, np.sqrt(np.mean(S**2, axis=0)))}
+        noise["backend_packing_seeds"] = list(getattr(backend, "seeds", []) or [])
+        noise["sigma_with_model_N"] = {r: float(s) for r, s in zip(responses, sigma)}
+    W = n[:, None] / sigma[None, :] ** 2
     X0 = _x(Y, B, W, allr)
     p_gap = lof_p(X0, M)
     z0 = (Y - B) / (sigma[None, :] / np.sqrt(n[:, None]))

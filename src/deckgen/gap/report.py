@@ -111,7 +111,11 @@ def markdown(report: dict[str, Any], measured_path: str, base_path: str) -> str:
     nz = report["noise"]
     L += ["## Find", "",
           f"Noise: {nz['source']}; sigma per response: " + ", ".join(f"{k} {v:.4g} N" for k, v in nz["sigma_N"].items())
-          + ".", f"Base-model misfit: chi2 = {g['chi2']:.1f} over {g['cells']} case-response cells, p = {g['p_value']:.3g}.",
+          + "." + ("" if "model_se_N" not in nz else
+                   f" The model is the mean over packing seeds {nz['backend_packing_seeds']}; its standard error ("
+                   + ", ".join(f"{k} {v:.4g} N" for k, v in nz["model_se_N"].items()) + ") joins the noise: sigma "
+                   + ", ".join(f"{k} {v:.4g} N" for k, v in nz["sigma_with_model_N"].items()) + "."),
+          f"Base-model misfit: chi2 = {g['chi2']:.1f} over {g['cells']} case-response cells, p = {g['p_value']:.3g}.",
           "", "Residual vs factor (weighted least squares of measured - base model on each factor):", "",
           "| response | factor | slope [N/unit] | p-value | R² | ΔAIC vs constant |", "|---|---|---|---|---|---|"]
     for r in report["residual_vs_factor"]:

@@ -314,6 +314,11 @@ def test_dem_backend_averages_over_packing_seeds(tmp_path):
             assert out.loc[i, r] == pytest.approx(ys[r].mean(), rel=1e-12)
             assert be.last_se.loc[i, r] == pytest.approx(ys[r].std(ddof=1) / math.sqrt(3), rel=1e-12)
     assert be.last_se["force_normal_N_mean_steady"].gt(0).all()
+    par = _noisy_backend(tmp_path, [11, 22, 33])
+    par.jobs = 2  # two runs at a time: the same means, in case order
+    pd.testing.assert_frame_equal(par.simulate(cases), out)
+    pd.testing.assert_frame_equal(par.last_se, be.last_se)
+    assert sorted(par.run_one.calls) == sorted(be.run_one.calls)
     with pytest.raises(GapInputError, match="at least two seeds"):
         make_backend("dem", tmp_path, seeds=[5])
     with pytest.raises(GapInputError, match="the fast backend has no packing"):

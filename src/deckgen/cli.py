@@ -193,7 +193,7 @@ def cmd_gap(args: argparse.Namespace) -> int:
             raise SpecError(f"--packing-seeds {args.packing_seeds!r}: not a list of integers (fix: e.g. 12345,202,303)") from None
     rep = gap(args.measured, args.base, args.out, backend=args.backend, candidates=cands, noise_cv=args.noise_cv,
               command=_command(args), cache=_cache(args), runs=Path(args.runs) if args.runs else None,
-              packing_seeds=seeds)
+              packing_seeds=seeds, jobs=args.jobs)
     print(f"{args.measured}: {rep['cases']} cases, {rep['rows']} rows, backend {rep['backend']}: "
           f"named effect {rep['named_effect'] or 'none'} ({rep['verdict']})")
     print(f"  {rep['reason']}")
@@ -267,6 +267,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--runs", help="dem backend: folder of the (cached) runs (default: OUT/dem_runs)")
     s.add_argument("--packing-seeds", help="dem backend: run every case on these packing seeds (comma-separated, "
                    ">= 2) and compare their mean; their standard error joins the noise")
+    s.add_argument("--jobs", type=int, default=1, choices=[1, 2, 3, 4],
+                   help="dem backend: engine runs at a time (use with --ranks 1)")
     engine_opts(s)
     s.set_defaults(func=cmd_gap)
     return p

@@ -18,7 +18,7 @@ __all__ = ["gap"]
 def gap(measured: str | Path, base: str | Path, out: str | Path, *, backend: str = "fast",
         candidates: list[str] | None = None, noise_cv: float | None = None, command: list[str] | None = None,
         cache: Path | None = None, runs: Path | None = None, packing_seeds: list[int] | None = None,
-        write: bool = True) -> dict[str, Any]:
+        jobs: int = 1, write: bool = True) -> dict[str, Any]:
     """Run the whole loop and write ``out/report.json``, ``report.md`` and the plots."""
     from deckgen.gap.backends import make_backend
     from deckgen.gap.data import read_measured
@@ -27,7 +27,7 @@ def gap(measured: str | Path, base: str | Path, out: str | Path, *, backend: str
 
     out = Path(out)
     m = read_measured(measured, base)
-    be = make_backend(backend, out, command=command, cache=cache, runs=runs, seeds=packing_seeds)
+    be = make_backend(backend, out, command=command, cache=cache, runs=runs, seeds=packing_seeds, jobs=jobs)
     report = run_gap(m, be, candidates=candidates, noise_cv=noise_cv)
     if write:
         write_report(report, out, str(measured), str(base))

@@ -45,7 +45,7 @@ class DemBackend:
     default_cv = 0.05
 
     def __init__(self, runs_dir: str | Path, *, command: list[str] | None = None, cache: Path | None = None,
-                 progress: bool = False, seeds: list[int] | None = None) -> None:
+                 progress: bool = False, seeds: list[int] | None = None, jobs: int = 1) -> None:
         self.runs_dir = Path(runs_dir)
         self.command = command
         self.cache = cache
@@ -57,6 +57,8 @@ class DemBackend:
             raise GapInputError("--packing-seeds: give at least two seeds (the scatter between them is the model's noise)")
         #: standard error of each simulated mean over the seeds (set by :meth:`simulate` when seeds are given)
         self.last_se: pd.DataFrame | None = None
+        #: engine runs at a time (each a subprocess; give each one rank)
+        self.jobs = max(1, int(jobs))
 
     def run_one(self, flat: dict) -> dict:
         from deckgen.deck import render_case
@@ -79,32 +81,42 @@ class DemBackend:
         self.log.append({"run": run_dir.name, "n_grains": summary.get("n_grains"), "wall_s": summary.get("wall_s")})
         return {r: (np.nan if summary.get(r) is None else float(summary[r])) for r in RESPONSE_COLUMNS}
 
-    def run_seeds(self, flat: dict) -> tuple[dict, dict]:
-        """Mean and standard error of the responses of ``flat`` over :attr:`seeds` (common to every case,
-        so base and candidate runs share their packings and the packing scatter partly cancels in their
-        difference)."""
-        ys = pd.DataFrame([self.run_one(dict(flat, **{"packing.seed": int(s)})) for s in self.seeds or []],
-                          columns=list(RESPONSE_COLUMNS))
-        return ys.mean().to_dict(), (ys.std(ddof=1) / np.sqrt(len(ys))).to_dict()
+    def _run_all(self, flats: list[dict]) -> list[dict]:
+        """:meth:`run_one` on every flat case, :attr:`jobs` at a time (threads: each run is an engine
+        subprocess; the packing cache locks per packing), results in input order."""
+        if self.jobs == 1 or len(flats) < 2:
+            return [self.run_one(f) for f in flats]
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=self.jobs) as pool:
+            return list(pool.map(self.run_one, flats))
 
     def simulate(self, cases: pd.DataFrame) -> pd.DataFrame:
+        """Responses of every case; with :attr:`seeds`, the mean over them, and their standard error in
+        :attr:`last_se`. The seeds are common to every case, so base and candidate runs share their
+        packings and the packing scatter partly cancels in their difference."""
         recs = cases.to_dict("records")
         if self.seeds is None:
             self.last_se = None
-            rows = [self.run_one(r) for r in recs]
-        else:
-            pairs = [self.run_seeds(r) for r in recs]
-            rows = [p[0] for p in pairs]
-            self.last_se = pd.DataFrame([p[1] for p in pairs], index=cases.index, columns=list(RESPONSE_COLUMNS))
-        return pd.DataFrame(rows, index=cases.index, columns=list(RESPONSE_COLUMNS))
+            rows = self._run_all(recs)
+            return pd.DataFrame(rows, index=cases.index, columns=list(RESPONSE_COLUMNS))
+        k = len(self.seeds)
+        ys = self._run_all([dict(r, **{"packing.seed": int(s)}) for r in recs for s in self.seeds])
+        means, ses = [], []
+        for i in range(len(recs)):
+            y = pd.DataFrame(ys[i * k:(i + 1) * k], columns=list(RESPONSE_COLUMNS))
+            means.append(y.mean().to_dict())
+            ses.append((y.std(ddof=1) / np.sqrt(k)).to_dict())
+        self.last_se = pd.DataFrame(ses, index=cases.index, columns=list(RESPONSE_COLUMNS))
+        return pd.DataFrame(means, index=cases.index, columns=list(RESPONSE_COLUMNS))
 
 
 def make_backend(name: str, out: Path, *, command: list[str] | None = None, cache: Path | None = None,
-                 runs: Path | None = None, seeds: list[int] | None = None):
+                 runs: Path | None = None, seeds: list[int] | None = None, jobs: int = 1):
     if name == "fast":
         if seeds:
             raise GapInputError("--packing-seeds: the fast backend has no packing (fix: drop it, or use --backend dem)")
         return FastBackend()
     if name == "dem":
-        return DemBackend(runs or out / "dem_runs", command=command, cache=cache, seeds=seeds)
+        return DemBackend(runs or out / "dem_runs", command=command, cache=cache, seeds=seeds, jobs=jobs)
     raise GapInputError(f"--backend {name}: unknown backend (fix: use fast or dem)")

@@ -34,20 +34,22 @@ def _value(s: str):
 
 
 def dem_measured(base: Path, out: Path, *, sets: dict[str, object], penetrations: list[float], seeds: list[int],
-                 runs: Path, command: list[str] | None, cache: Path | None) -> pd.DataFrame:
+                 runs: Path, command: list[str] | None, cache: Path | None, jobs: int = 1) -> pd.DataFrame:
     from deckgen.gap.backends import DemBackend
 
-    be = DemBackend(runs, command=command, cache=cache)
+    be = DemBackend(runs, command=command, cache=cache, jobs=jobs)
     flat0 = flat_case(load_case(base))
-    rows = []
+    keys, flats = [], []
     for p in penetrations:
         for r, seed in enumerate(seeds, 1):
             f = dict(flat0, **sets)
             f["kinematics.penetration_mm"] = p
             f["packing.seed"] = seed
             f["name"] = f"{flat0['name']}_measured"
-            y = be.run_one(f)
-            rows.append({"kinematics.penetration_mm": p, "replicate": r, **{k: y[k] for k in RESPONSE_COLUMNS}})
+            keys.append((p, r))
+            flats.append(f)
+    rows = [{"kinematics.penetration_mm": p, "replicate": r, **{k: y[k] for k in RESPONSE_COLUMNS}}
+            for (p, r), y in zip(keys, be._run_all(flats))]
     df = pd.DataFrame(rows)
     out.parent.mkdir(parents=True, exist_ok=True)
     with out.open("w") as fh:
@@ -119,6 +121,7 @@ def main(argv: list[str] | None = None) -> int:
     d.add_argument("--penetrations", default="1.0,1.5,2.0")
     d.add_argument("--seeds", default="101,202")
     d.add_argument("--ranks", type=int, default=1)
+    d.add_argument("--jobs", type=int, default=1, choices=[1, 2, 3, 4], help="engine runs at a time")
     d.add_argument("--engine-cmd")
     d.add_argument("--cache")
     v = sub.add_parser("validate")
@@ -139,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
         df = dem_measured(Path(a.base), Path(a.out), sets={k: _value(v) for k, v in sets.items()},
                           penetrations=[float(x) for x in a.penetrations.split(",")],
                           seeds=[int(x) for x in a.seeds.split(",")], runs=Path(a.runs), command=cmd,
-                          cache=Path(a.cache) if a.cache else None)
+                          cache=Path(a.cache) if a.cache else None, jobs=a.jobs)
         print(df.to_string(index=False))
         return 0
     if a.cmd == "validate":

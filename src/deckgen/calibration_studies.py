@@ -101,6 +101,11 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("bending x0.3 and twisting x10, tau/sigma=0.5", {"bending_strength_factor": 0.3, "twisting_strength_factor": 10.0,
                                                        "shear_strength_MPa": 30.0}),
     ("twisting x100, clumps of 16", {"twisting_strength_factor": 100.0, "clump_size": 16}),
+    # with clumps of 16 and twisting x100 (M 11.9): which knob trades UCS/E for UCS/BTS?
+    ("t100c16 + sigma_c 240 (tau/sigma 0.25)", {"twisting_strength_factor": 100.0, "clump_size": 16,
+                                                "tensile_strength_MPa": 240.0}),
+    ("t100c16 + g 0.2", {"twisting_strength_factor": 100.0, "clump_size": 16, "gap_tolerance": 0.2}),
+    ("t100c16 + E_c/E_b 1", {"twisting_strength_factor": 100.0, "clump_size": 16, "contact_modulus_ratio": 1.0}),
     ("twisting x10 + clumps of 16 + tau/sigma=0.5", {"twisting_strength_factor": 10.0, "clump_size": 16,
                                                     "shear_strength_MPa": 30.0}),
 ]

@@ -269,6 +269,8 @@ def test_dem_switches_change_the_deck(tmp_path):
     assert "addforce" not in deck0
     lines = [ln for ln in deck1.splitlines() if ln.startswith("fix") and "addforce" in ln]
     assert len(lines) == 1 and "confine_ymax" in lines[0]  # y min is a fixed face of tiny_cut
+    # only grains still in the face slab are pushed: an ejected chip must not be accelerated for ever
+    assert lines[0].split()[-2:] == ["region", "conf_ymax"]
     n = int(next(ln for ln in deck1.splitlines() if ln.startswith("# confining stress")).split(": ")[1].split()[0])
     f = float(lines[0].split()[5])
     assert n * f == pytest.approx(-4.0e6 * 16e-3 * 8e-3, rel=1e-6)

@@ -301,6 +301,11 @@ def write_card(card: MaterialCard, path: str | Path, header: str = "") -> Path:
 
 
 # =============================================================================== parameters
+#: MicroParams fields (same names as bonds.*) added after points were recorded: they enter keys and case
+#: overrides only away from their defaults, so earlier points keep their keys
+OPTIONAL_BOND_FIELDS = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor")
+
+
 @dataclass(frozen=True)
 class MicroParams:
     """Physical micro-parameters of one evaluation (engineering units, as in case files)."""
@@ -320,6 +325,11 @@ class MicroParams:
     bending_strength_factor: float = 1.0  # critical bending torque / parallel-bond value (bonds.*)
     twisting_strength_factor: float = 1.0  # critical twisting torque / parallel-bond value (bonds.*)
 
+    @classmethod
+    def optional_defaults(cls) -> dict[str, float]:
+        """The bonds.* fields that enter keys and case overrides only away from their defaults: {name: default}."""
+        return {n: cls.__dataclass_fields__[n].default for n in OPTIONAL_BOND_FIELDS}
+
     def key(self) -> str:
         """Hash of the values rounded to 10 significant digits (folder and table key).
 
@@ -334,8 +344,7 @@ class MicroParams:
             del vals["contact_modulus_ratio"]
         if vals["clump_size"] == 1:
             del vals["clump_size"], vals["clump_strength_factor"], vals["clump_stiffness_factor"]
-        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
-                              ("twisting_strength_factor", 1.0)):
+        for name, default in self.optional_defaults().items():
             if vals[name] == default:
                 del vals[name]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
@@ -349,8 +358,7 @@ class MicroParams:
         if self.clump_size != 1:
             bonds.update(clump_size=int(self.clump_size), clump_strength_factor=self.clump_strength_factor,
                          clump_stiffness_factor=self.clump_stiffness_factor)
-        for name, default in (("unbonded_fraction", 0.0), ("bending_strength_factor", 1.0),
-                              ("twisting_strength_factor", 1.0)):
+        for name, default in self.optional_defaults().items():
             if getattr(self, name) != default:
                 bonds[name] = getattr(self, name)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}

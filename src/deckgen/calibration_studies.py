@@ -275,9 +275,7 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
                     contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
                     clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
                     clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
-                    unbonded_fraction=b.get("unbonded_fraction", 0.0),
-                    bending_strength_factor=b.get("bending_strength_factor", 1.0),
-                    twisting_strength_factor=b.get("twisting_strength_factor", 1.0))
+                    **{n: b.get(n, d) for n, d in MicroParams.optional_defaults().items()})
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 

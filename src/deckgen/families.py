@@ -92,22 +92,21 @@ def calibrated_card(rock: str) -> dict[str, Any] | None:
     ``{"bonds": ..., "contact": ...}``: the card's ``calibration.base`` blocks with the ``calibrated``
     values over them; without a calibrated contact modulus, E_c = E_b when the calibration tied them,
     else the base's (or the spec default)."""
+    from deckgen.calibrate import load_card
     from deckgen.render import repo_root
+    from deckgen.spec import Contact
 
     path = repo_root() / "cases" / "materials" / f"{rock}.yaml"
     if not path.is_file():
         return None
-    card = yaml.safe_load(path.read_text())
-    if not (card.get("provenance") or {}).get("converged") or not card.get("calibrated"):
+    card = load_card(path)  # the validated card, as the calibration reads it
+    if card.provenance is None or not card.provenance.converged or card.calibrated is None:
         return None
-    from deckgen.spec import Contact
-
-    cal, setup = card["calibrated"], card.get("calibration") or {}
-    base = setup.get("base") or {}
-    bonds = {**(base.get("bonds") or {}), **(cal.get("bonds") or {})}
-    contact = {**(base.get("contact") or {}), **(cal.get("contact") or {})}
+    setup = card.calibration
+    bonds = {**(setup.base.get("bonds") or {}), **card.calibrated.bonds}
+    contact = {**(setup.base.get("contact") or {}), **card.calibrated.contact}
     if "youngs_modulus_GPa" not in contact:
-        contact["youngs_modulus_GPa"] = (bonds["youngs_modulus_GPa"] if setup.get("tie_contact_modulus", True)
+        contact["youngs_modulus_GPa"] = (bonds["youngs_modulus_GPa"] if setup.tie_contact_modulus
                                          else Contact().youngs_modulus_GPa)
     return {"bonds": bonds, "contact": contact}
 

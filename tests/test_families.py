@@ -11,6 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -37,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 86 + 2 * len(NAMES)  # 86 case files + index.csv and README.md per family
+    assert len(files) == 102 + 2 * len(NAMES)  # 102 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -49,7 +50,7 @@ def test_case_counts_per_family():
     counts = {(f, s): len(_files(f, s)) for f in NAMES for s in fam.SCALES}
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
-        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 16,
+        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 32,  # 16 + 16 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
         ("odc", "full"): 10, ("odc", "reduced"): 12,  # 9 of Table 5.1 + 3 supplementary
     }
@@ -207,6 +208,26 @@ def test_middle_window_puts_the_contact_patch_mid_block():
     assert case.kinematics.travel_mm == travel and list(case.outputs.steady_window) == [a, b]
 
 
+def test_linear_replicates_differ_only_in_name_and_packing_seed():
+    """Replicate packings of the p series at S 25 and 51 mm (full scale): two extra seeds each."""
+    reps = [p for p in _files("linear_ccs", "reduced") if "_k" in p.stem]
+    assert len(reps) == 2 * 4 * len(fam.LINEAR_REPLICATE_SPACINGS)
+    for p in reps:
+        base_name, seed = p.stem.rsplit("_k", 1)
+        base = load_case(p.with_name(base_name + ".yaml")).model_dump()
+        rep = load_case(p).model_dump()
+        assert base["packing"]["seed"] == fam.DEFAULT_PACKING_SEED and rep["packing"]["seed"] == int(seed)
+        assert int(seed) in fam.LINEAR_REPLICATE_SEEDS
+        for d in (base, rep):
+            d.pop("name")
+            d["packing"].pop("seed")
+        assert rep == base
+    import pandas as pd
+
+    idx = pd.read_csv(ROOT / "cases/linear_ccs/index.csv")
+    assert set(idx["packing_seed"]) == {fam.DEFAULT_PACKING_SEED, *fam.LINEAR_REPLICATE_SEEDS}
+
+
 def test_report_table_and_plots(tmp_path):
     dirs = []
     for i, (case, fn, fr) in enumerate([("lin_red_s25_p1p9", 100.0, 10.0), ("lin_red_s25_p3p8", 200.0, 30.0)]):
@@ -258,6 +279,36 @@ def test_report_cli_takes_run_folders_after_the_options(tmp_path):
 
     assert list(pd.read_csv(tmp_path / "out" / "family_table.csv")["case"]) == ["lin_red_s25_p1p9"]
 
+
+
+def test_combine_pools_tables_made_apart_with_factors_from_the_index(tmp_path):
+    """Replicate runs made later join the first table; factor columns come from the current index.csv."""
+    import pandas as pd
+
+    first = pd.DataFrame({"case": ["lin_red_s25_p1p9", "lin_red_s25_p3p8"], "force_normal_N_mean_steady": [100.0, 150.0],
+                          "force_rolling_N_mean_steady": [10.0, 30.0], "rolling_to_normal_ratio_1": [0.1, 0.2]})  # written before packing_seed existed
+    later = pd.DataFrame({"case": ["lin_red_s25_p1p9_k202", "lin_red_s25_p3p8_k202", "lin_red_s25_p3p8"],
+                          "force_normal_N_mean_steady": [110.0, 160.0, 155.0],
+                          "force_rolling_N_mean_steady": [13.2, 40.0, 34.1], "rolling_to_normal_ratio_1": [0.12, 0.25, 0.22]})
+    first.to_csv(tmp_path / "a.csv", index=False)
+    later.to_csv(tmp_path / "b.csv", index=False)
+    rc = fam.main(["combine", "--family", "linear_ccs", "--index", str(ROOT / "cases/linear_ccs/index.csv"),
+                   "--out", str(tmp_path / "out"), str(tmp_path / "a.csv"), str(tmp_path / "b.csv")])
+    assert rc == 0
+    t = pd.read_csv(tmp_path / "out" / "family_table.csv").set_index("case")
+    assert len(t) == 4 and t.loc["lin_red_s25_p3p8", "force_normal_N_mean_steady"] == 155.0  # the later row wins
+    assert t.loc["lin_red_s25_p1p9", "packing_seed"] == 12345 and t.loc["lin_red_s25_p1p9_k202", "packing_seed"] == 202
+    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend").loc["fr_fn_rises_with_p"]
+    assert tr["runs"] == 4 and tr["groups"] == 1
+    # within-group OLS on the four runs: slope of Fr/Fn per mm of full-scale p
+    x = np.array([1.9, 3.8, 1.9, 3.8])
+    y = np.array([0.1, 0.22, 0.12, 0.25])
+    assert tr["slope"] == pytest.approx(np.polyfit(x, y, 1)[0])
+    assert len(list((tmp_path / "out" / "plots").glob("*.png"))) == 5
+    pd.DataFrame({"case": ["no_such_case"]}).to_csv(tmp_path / "c.csv", index=False)
+    with pytest.raises(SystemExit):
+        fam.main(["combine", "--family", "linear_ccs", "--index", str(ROOT / "cases/linear_ccs/index.csv"),
+                  "--out", str(tmp_path / "out2"), str(tmp_path / "c.csv")])
 
 
 def _linear_table(fn_of_s, ratio_of_p, seed=0):

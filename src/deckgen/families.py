@@ -324,6 +324,12 @@ SEED001_PAIRS = tuple((S, p) for S in (25, 51, 76) for p in (1.9, 3.8, 6.4)) + (
     (25, 7.6), (51, 7.6), (76, 7.6), (100, 1.9), (100, 3.8), (100, 6.4), (100, 7.6))
 REDUCED_DISC = 1 / 8  # linear_ccs and rotary: disc geometry factor
 REDUCED_PEN = 1 / 2  # linear_ccs and rotary: penetration factor (grains are not scaled)
+#: linear_ccs reduced: extra packing seeds (replicate runs) of the penetration series at these full-scale
+#: spacings, the cheapest two (Fr/Fn vs p scatters with single chip events at this block size; docs/families.md)
+LINEAR_REPLICATE_SEEDS = (202, 303)
+LINEAR_REPLICATE_SPACINGS = (25, 51)
+#: the packing seed of a case that does not set one (spec default)
+DEFAULT_PACKING_SEED = 12345
 
 
 def _ccs_cutter(f: float, scale: str) -> dict[str, Any]:
@@ -400,9 +406,16 @@ def linear_ccs() -> list[CaseDef]:
             data = _cutting(name, rock, packing, bonds, contact, block, _ccs_cutter(f, scale), kin, outputs)
             if scale == "full":
                 data["run"] = {"max_steps": _max_steps(data)}
-            out.append(CaseDef(fam, scale, name, header, data, {
-                "rock": rock, "penetration_full_mm": p_full, "penetration_mm": p, "disc_diameter_mm": _r(CCS_D_MM * f),
-                "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp}))
+            factors = {"rock": rock, "penetration_full_mm": p_full, "penetration_mm": p, "disc_diameter_mm": _r(CCS_D_MM * f),
+                       "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp}
+            out.append(CaseDef(fam, scale, name, header, data, {**factors, "packing_seed": DEFAULT_PACKING_SEED}))
+            if scale == "reduced" and S_full in LINEAR_REPLICATE_SPACINGS:
+                for seed in LINEAR_REPLICATE_SEEDS:
+                    rep = f"{name}_k{seed}"
+                    rdata = {**data, "name": rep, "packing": {**packing, "seed": seed}}
+                    rheader = [header[0], f"Replicate of {name} on packing seed {seed} (only the packing differs).",
+                               *header[1:]]
+                    out.append(CaseDef(fam, scale, rep, rheader, rdata, {**factors, "packing_seed": seed}))
     return out
 
 
@@ -895,7 +908,10 @@ def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
         for key, g in (t.groupby(groups) if groups else [((), t)]):
             g = g.sort_values(x)
             label = ", ".join(f"{k} {v}" for k, v in zip(groups, key if isinstance(key, tuple) else (key,))) or family
-            ax.plot(g[x], g[y], "o-", label=label)
+            mean = g.groupby(x)[y].mean()  # replicate packings (same factors): line through their mean
+            (line,) = ax.plot(mean.index, mean.to_numpy(), "o-" if len(mean) == len(g) else "-", label=label)
+            if len(mean) < len(g):
+                ax.plot(g[x], g[y], "o", color=line.get_color(), alpha=0.6, markersize=4)
         if x == "rotary_radius_mm":
             ax.set_xscale("log")
         ax.set_xlabel(x)
@@ -910,7 +926,29 @@ def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
 
 
 def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], out: str | Path) -> Path:
-    table = family_table(index_csv, parsed_dirs)
+    return report_table(family, family_table(index_csv, parsed_dirs), out)
+
+
+def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None) -> "Any":
+    """Family tables of runs made apart (e.g. a family's first runs and later replicate packings), one row
+    per case; a case in several tables keeps its last row. With ``index_csv`` the factor columns are taken
+    from the current index (tables written before a factor column was added get it)."""
+    import pandas as pd
+
+    frames = [pd.read_csv(t, keep_default_na=False) for t in tables]
+    table = pd.concat(frames, ignore_index=True).drop_duplicates("case", keep="last").reset_index(drop=True)
+    if index_csv is None:
+        return table
+    idx = pd.read_csv(index_csv, keep_default_na=False)
+    unknown = sorted(set(table["case"]) - set(idx["case"]))
+    if unknown:
+        raise ValueError(f"{index_csv}: no row for the cases {', '.join(unknown)} (fix: the family's index.csv)")
+    runs = table.drop(columns=[c for c in table.columns if c in idx.columns and c != "case"])
+    return idx.merge(runs, on="case", how="inner")
+
+
+def report_table(family: str, table: "Any", out: str | Path) -> Path:
+    """family_table.csv, plots, trends.csv (and regression.csv) of a family table into ``out``."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     path = out / "family_table.csv"
@@ -933,13 +971,27 @@ def _root(arg: str | None) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m deckgen.families", description=__doc__.split("\n\n")[0])
-    p.add_argument("command", choices=["write", "check", "list", "report"])
+    p.add_argument("command", choices=["write", "check", "list", "report", "combine"],
+                   help="combine: the report of family tables made apart (e.g. later replicate runs), given as arguments")
     p.add_argument("--root", help="repository root (default: the one deckgen runs from)")
     p.add_argument("--family", choices=list(FAMILIES), help="report: the family")
     p.add_argument("--index", help="report: the family's index.csv")
     p.add_argument("--out", help="report: output folder (family_table.csv, plots/)")
-    p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json)")
+    p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json); combine: family_table.csv files")
     args = p.parse_intermixed_args(argv)  # run folders may follow the options, as in rules/families.smk
+    if args.command == "combine":
+        if not (args.family and args.out and args.parsed):
+            p.error("combine needs --family, --out and the family_table.csv files")
+        missing = [t for t in args.parsed if not Path(t).is_file()]
+        if missing:
+            p.error(f"combine: no such family table: {', '.join(missing)}")
+        try:
+            table = combine_tables(args.parsed, args.index)
+        except ValueError as exc:
+            p.error(f"combine: {exc}")
+        path = report_table(args.family, table, args.out)
+        print(f"wrote {path} ({len(table)} runs from {len(args.parsed)} tables), trends.csv and plots")
+        return 0
     if args.command == "report":
         if not (args.family and args.index and args.out):
             p.error("report needs --family, --index and --out")

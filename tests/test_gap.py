@@ -16,7 +16,7 @@ from deckgen.gap.catalogue import BY_ID, CATALOGUE
 from deckgen.gap.data import flat_case
 from deckgen.gap.fast import K_SIDE, predict_row
 from deckgen.gap.synth import KINDS, make_set, run_battery
-from deckgen.spec import Case, load_case
+from deckgen.spec import Case, SpecError, load_case
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "tests" / "data" / "cases" / "gap_base.yaml"
@@ -355,3 +355,32 @@ def test_model_seed_scatter_keeps_a_noisy_model_from_naming_an_effect(tmp_path):
     without = run_gap(m, _NoSE(_noisy_backend(tmp_path, [11, 22, 33])))
     assert without["verdict"] != "within_noise"
     assert without["gap_test"]["chi2"] > 3 * with_se["gap_test"]["chi2"]
+
+
+
+def test_dem_example_and_validation_cases_fit_their_block():
+    """Every DEM case the documented example (rules/gap.smk) and the fast-vs-DEM validation render passes
+    the path check render makes before packing (a failure there costs the engine runs made before it)."""
+    import re
+
+    from deckgen.deck import cutter_path
+    from deckgen.gap.data import case_from_flat
+    from deckgen.gap.examples import VALIDATION
+
+    rule = (ROOT / "workflow/rules/gap.smk").read_text()
+    pens = [float(x) for x in re.search(r"--penetrations ([0-9.,]+)", rule).group(1).split(",")]
+    cands = re.search(r"--candidates ([a-z_,]+)", rule).group(1).split(",")
+    assert len(pens) >= 4 and "free_rolling" in cands  # >= 4 cases: one is held out
+    flat0 = flat_case(load_case(ROOT / "cases/gap/dem_base.yaml"))
+    runs = [dict(sets) for sets in VALIDATION.values()]  # the validation: each switch at the base case's p
+    for eid in cands:  # the example: the DEM backend's grid of each candidate's magnitude at every p
+        e = BY_ID[eid]
+        for m in ([None] if e.magnitude is None else e.magnitude.grid(3)):
+            sets = {**e.switch, **({} if m is None else {e.magnitude.field: float(m)})}
+            runs += [{**sets, "kinematics.penetration_mm": p} for p in pens]
+    for sets in runs:
+        case = case_from_flat({**flat0, **sets})
+        cutter_path(case, case.cutter.diameter_mm * 1e-3 / 2)  # SpecError when the path leaves the block
+    with pytest.raises(SpecError, match="leaves the block"):  # the r = 20 mm the validation first used
+        case = case_from_flat({**flat0, **VALIDATION["rotary_r30mm"], "kinematics.rotary_radius_mm": 20.0})
+        cutter_path(case, case.cutter.diameter_mm * 1e-3 / 2)

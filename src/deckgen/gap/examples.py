@@ -64,7 +64,7 @@ VALIDATION = {
     "free_rolling": {"kinematics.spin": "rolling"},
     "wear_flat_0.6mm": {"cutter.wear_flat_mm": 0.6},
     "tilt_8deg": {"cutter.tilt_deg": 8.0},
-    "rotary_r20mm": {"kinematics.mode": "rotary", "kinematics.rotary_radius_mm": 20.0},
+    "rotary_r30mm": {"kinematics.mode": "rotary", "kinematics.rotary_radius_mm": 30.0},
     "relieved_S4mm": {"kinematics.neighbour_spacing_mm": 4.0},
     "confinement_5MPa": {"specimen.confining_stress_MPa": 5.0},
 }

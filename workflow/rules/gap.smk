@@ -2,7 +2,7 @@
 #   snakemake results/gap/<name>/report.json   for a study listed under `gap:` in the config
 #       (gap: {<name>: {measured: CSV, base: CASE, backend: fast|dem}})
 #   snakemake results/gap/seed002_demo/report.json   real data: seed 002 RCM forces vs a linear model
-#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc (slow; 3 packing
+#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc, three candidates (slow; 3 packing
 #       seeds for the measured rows and 3 others for every model case)
 # Engine runs use one rank each, gap_ranks of them at a time (default 1).
 
@@ -47,7 +47,7 @@ rule gap_dem_measured:
     shell:
         "python -m deckgen.gap.examples dem-measured --base {input.base} --out {output.csv} "
         "--runs {params.runs} --cache {params.cache} --set kinematics.spin=rolling "
-        "--penetrations 1.0,1.5,2.0 --seeds 101,404,505 --ranks 1 --jobs {threads} > {log} 2>&1"
+        "--penetrations 1.0,1.5,2.0,2.5 --seeds 101,404,505,606,707 --ranks 1 --jobs {threads} > {log} 2>&1"
 
 
 rule gap_dem_example:
@@ -69,7 +69,7 @@ rule gap_dem_example:
         cache=f"{RESULTS}/.cache",
     shell:
         "deckgen gap --measured {input.measured} --base {input.base} --out {params.out} --backend dem "
-        "--candidates free_rolling --packing-seeds 12345,202,303 --runs {params.runs} --ranks 1 --jobs {threads} "
+        "--candidates free_rolling,wear_flat,tilt --packing-seeds 12345,202,303 --runs {params.runs} --ranks 1 --jobs {threads} "
         "--cache {params.cache} "
         "> {log} 2>&1"
 

@@ -95,7 +95,10 @@ CATALOGUE: tuple[Effect, ...] = (
         responses=(R,),
         factors=("kinematics.penetration_mm", "contact.cutter_friction"),
         signature=("rolling force over-predicted by about mu times the total contact force in every case, normal "
-                   "and side force unchanged: a constant offset of the rolling-to-normal force ratio"),
+                   "and side force unchanged: a constant offset of the rolling-to-normal force ratio (the lab-scale "
+                   "CSM picture). In deckgen's DEM, at cut depths of one or two grains, the sliding friction also "
+                   "pulls the disc into the rock, so a rolling disc carries a normal force 2-6 times higher "
+                   "(docs/discrepancy.md, DEM end to end)"),
         switch={"kinematics.spin": "rolling"},
         evidence="seed 003 sec. 5.5 (29 % force change from the friction moment)",
     ),

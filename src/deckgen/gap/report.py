@@ -44,7 +44,8 @@ def plot_parity(report: dict[str, Any], path: Path) -> Path:
                 continue
             for sub, fill in (("fit", True), ("held_out", False)):
                 s = pc["subset"] == sub
-                ax.scatter(y[s], pc.loc[s, col], marker=mk, facecolors=None if fill or mk == "x" else "none",
+                ax.scatter(y[s], pc.loc[s, col], marker="+" if mk == "x" and not fill else mk,  # held-out: + / hollow o
+                           s=60 if mk == "x" and not fill else None, facecolors=None if fill or mk == "x" else "none",
                            edgecolors="C0" if mk == "o" else None, color="C0" if mk == "o" else "C3",
                            label=f"{lab} ({sub.replace('_', '-')})")
         lo = float(min(y.min(), pc[[f"{r}_base", f"{r}_after"]].min().min()))

@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 102 + 2 * len(NAMES)  # 102 case files + index.csv and README.md per family
+    assert len(files) == 110 + 2 * len(NAMES)  # 110 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -50,7 +50,7 @@ def test_case_counts_per_family():
     counts = {(f, s): len(_files(f, s)) for f in NAMES for s in fam.SCALES}
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
-        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 32,  # 16 + 16 replicate packings
+        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
         ("odc", "full"): 10, ("odc", "reduced"): 12,  # 9 of Table 5.1 + 3 supplementary
     }
@@ -209,7 +209,7 @@ def test_middle_window_puts_the_contact_patch_mid_block():
 
 
 def test_linear_replicates_differ_only_in_name_and_packing_seed():
-    """Replicate packings of the p series at S 25 and 51 mm (full scale): two extra seeds each."""
+    """Replicate packings of the p series at S 25, 51 and 76 mm (full scale): two extra seeds each."""
     reps = [p for p in _files("linear_ccs", "reduced") if "_k" in p.stem]
     assert len(reps) == 2 * 4 * len(fam.LINEAR_REPLICATE_SPACINGS)
     for p in reps:
@@ -322,6 +322,7 @@ def _linear_table(fn_of_s, ratio_of_p, seed=0):
             fn = fn_of_s(S) * (1 + 0.02 * rng.standard_normal())
             rows.append({"case": f"c{S}_{p}", "spacing_mm": S, "penetration_mm": p, "spacing_full_mm": 8 * S,
                          "penetration_full_mm": 2 * p, "force_normal_N_mean_steady": fn,
+                         "ridge_grains_1": fam.ridge_width_mm(S, p, 1.5625, 20.0) / 1.7,
                          "rolling_to_normal_ratio_1": ratio_of_p(p) * (1 + 0.02 * rng.standard_normal())})
     return pd.DataFrame(rows)
 
@@ -338,6 +339,22 @@ def test_trend_table_finds_the_seed_trends_and_their_size():
     assert fn["p_value"] < 1e-6 and bool(fn["sign_as_seed"]) and bool(fn["significant_5pct"])
     assert fr["change_1"] == pytest.approx(3.8 / 0.95 - 1, rel=0.1) and bool(fr["sign_as_seed"])
     assert fn["seed_change_1"] == pytest.approx(193.8 / 122.4 - 1)  # seed 001 Tables 3-4
+    ridge = t.loc["fr_fn_rises_with_p_intact_ridge"]  # only S 9.5 and 12.5 mm (76, 100 full) leave >= 3 grains
+    assert ridge["runs"] == 8 and ridge["groups"] == 2 and bool(ridge["sign_as_seed"])
+    assert ridge["change_1"] == pytest.approx(3.8 / 0.95 - 1, rel=0.1)
+
+
+def test_ridge_between_neighbour_grooves():
+    """Reduced S 25 mm (3.125), p 7.6 mm (3.8): the grooves of the 1.5625 mm tip with 20 deg flanks overlap;
+    full scale S 25, p 7.6 leaves 7 mm (5.6 grain diameters of r 0.5-0.75 mm)."""
+    assert fam.ridge_width_mm(3.125, 3.8, 1.5625, 20.0) == pytest.approx(3.125 - 1.5625 - 7.6 * math.tan(math.radians(20)))
+    assert fam.ridge_width_mm(3.125, 3.8, 1.5625, 20.0) < 0
+    assert fam.ridge_width_mm(25, 7.6, 12.5, 20.0) == pytest.approx(6.968, abs=1e-3)
+    import pandas as pd
+
+    idx = pd.read_csv(ROOT / "cases/linear_ccs/index.csv").set_index("case")
+    assert idx.loc["lin_red_s76_p7p6", "ridge_grains_1"] >= 3 > idx.loc["lin_red_s51_p1p9", "ridge_grains_1"]
+    assert idx.loc["lin_full_s25_p7p6", "ridge_grains_1"] == pytest.approx(5.57)
 
 
 def test_trend_table_reports_a_wrong_sign_and_no_trend():

@@ -325,11 +325,19 @@ SEED001_PAIRS = tuple((S, p) for S in (25, 51, 76) for p in (1.9, 3.8, 6.4)) + (
 REDUCED_DISC = 1 / 8  # linear_ccs and rotary: disc geometry factor
 REDUCED_PEN = 1 / 2  # linear_ccs and rotary: penetration factor (grains are not scaled)
 #: linear_ccs reduced: extra packing seeds (replicate runs) of the penetration series at these full-scale
-#: spacings, the cheapest two (Fr/Fn vs p scatters with single chip events at this block size; docs/families.md)
+#: spacings, the cheapest three (Fr/Fn vs p scatters with single chip events at this block size; docs/families.md)
 LINEAR_REPLICATE_SEEDS = (202, 303)
-LINEAR_REPLICATE_SPACINGS = (25, 51)
+LINEAR_REPLICATE_SPACINGS = (25, 51, 76)
 #: the packing seed of a case that does not set one (spec default)
 DEFAULT_PACKING_SEED = 12345
+
+
+def ridge_width_mm(spacing_mm: float, penetration_mm: float, tip_width_mm: float, flank_angle_deg: float) -> float:
+    """Width of the intact rock ridge left at the block surface between two grooves of a CCS disc (flat tip,
+    straight flanks at ``flank_angle_deg`` to the mid-plane; tip rounding neglected) cut ``spacing_mm``
+    apart to ``penetration_mm``; negative when the grooves overlap. At reduced scale the penetration factor
+    (1/2) is 4x the geometry factor (1/8), so the ridge is far narrower, in grains, than in seed 001."""
+    return spacing_mm - (tip_width_mm + 2.0 * penetration_mm * math.tan(math.radians(flank_angle_deg)))
 
 
 def _ccs_cutter(f: float, scale: str) -> dict[str, Any]:
@@ -406,8 +414,11 @@ def linear_ccs() -> list[CaseDef]:
             data = _cutting(name, rock, packing, bonds, contact, block, _ccs_cutter(f, scale), kin, outputs)
             if scale == "full":
                 data["run"] = {"max_steps": _max_steps(data)}
+            ridge = ridge_width_mm(S, p, CCS_TIP_WIDTH_MM * f, 20.0)
             factors = {"rock": rock, "penetration_full_mm": p_full, "penetration_mm": p, "disc_diameter_mm": _r(CCS_D_MM * f),
-                       "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp}
+                       "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp,
+                       "ridge_width_mm": _r(ridge, 3),
+                       "ridge_grains_1": _r(ridge / (packing["radius_min_mm"] + packing["radius_max_mm"]), 2)}
             out.append(CaseDef(fam, scale, name, header, data, {**factors, "packing_seed": DEFAULT_PACKING_SEED}))
             if scale == "reduced" and S_full in LINEAR_REPLICATE_SPACINGS:
                 for seed in LINEAR_REPLICATE_SEEDS:
@@ -770,6 +781,11 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "penetration_full_mm", ("spacing_full_mm",), +1, (31.7 / 208.6) / (9.3 / 118.4) - 1,
               "seed 001 Table 4, LS-DYNA at S 100 mm: Fr/Fn 9.3/118.4 at p 1.9 mm -> 31.7/208.6 at p 7.6 mm",
               x_range=(1.9, 7.6)),
+        Trend("fr_fn_rises_with_p_intact_ridge", "the same, only runs whose neighbouring grooves leave a ridge of at "
+              "least 3 grain diameters (at reduced scale S >= 76 mm; at S <= 51 mm the grooves overlap or leave "
+              "<= 2.4 grains, which seed 001's geometry never does)", "rolling_to_normal_ratio_1",
+              "penetration_full_mm", ("spacing_full_mm",), +1, (31.7 / 208.6) / (9.3 / 118.4) - 1,
+              "seed 001 Table 4 (as above)", x_range=(1.9, 7.6), only="ridge_grains_1 >= 3"),
     ),
     "rotary": (
         Trend("fs_falls_with_r", "side force falls with the path radius r", "force_side_N_mean_steady",
@@ -823,7 +839,10 @@ def trend_table(family: str, table: "Any") -> "Any":
     for tr in TRENDS.get(family, ()):
         t = table
         if tr.only:
-            t = t.query(tr.only)
+            try:
+                t = t.query(tr.only)
+            except (KeyError, pd.errors.UndefinedVariableError):  # a table without the column (older runs)
+                t = t.iloc[0:0]
         t = t.dropna(subset=[tr.x, tr.y])
         t = t.assign(_x=np.log(t[tr.x]) if tr.log_x else t[tr.x], _y=t[tr.y].abs() if tr.abs_y else t[tr.y])
         t["_g"] = t[list(tr.groups)].astype(str).agg("|".join, axis=1) if tr.groups and len(t) else "all"

@@ -364,6 +364,7 @@ def test_dem_example_and_validation_cases_fit_their_block():
     import re
 
     from deckgen.deck import cutter_path
+    from deckgen.gap.backends import DemBackend
     from deckgen.gap.data import case_from_flat
     from deckgen.gap.examples import VALIDATION
 
@@ -372,14 +373,14 @@ def test_dem_example_and_validation_cases_fit_their_block():
     cands = re.search(r"--candidates ([a-z_,]+)", rule).group(1).split(",")
     assert len(pens) >= 4 and "free_rolling" in cands  # >= 4 cases: one is held out
     flat0 = flat_case(load_case(ROOT / "cases/gap/dem_base.yaml"))
-    runs = [dict(sets) for sets in VALIDATION.values()]  # the validation: each switch at the base case's p
-    for eid in cands:  # the example: the DEM backend's grid of each candidate's magnitude at every p
+    runs = [{**flat0, **sets} for sets in VALIDATION.values()]  # the validation: each switch at the base case's p
+    cases = pd.DataFrame([{**flat0, "kinematics.penetration_mm": p} for p in pens])
+    for eid in cands:  # the example: the DEM backend's grid of each candidate's magnitude, applied as the loop does
         e = BY_ID[eid]
-        for m in ([None] if e.magnitude is None else e.magnitude.grid(3)):
-            sets = {**e.switch, **({} if m is None else {e.magnitude.field: float(m)})}
-            runs += [{**sets, "kinematics.penetration_mm": p} for p in pens]
-    for sets in runs:
-        case = case_from_flat({**flat0, **sets})
+        for m in ([None] if e.magnitude is None else e.magnitude.grid(DemBackend.grid_points)):
+            runs += e.apply(cases, m, ["kinematics.penetration_mm"]).to_dict("records")
+    for flat in runs:
+        case = case_from_flat(flat)
         cutter_path(case, case.cutter.diameter_mm * 1e-3 / 2)  # SpecError when the path leaves the block
     with pytest.raises(SpecError, match="leaves the block"):  # the r = 20 mm the validation first used
         case = case_from_flat({**flat0, **VALIDATION["rotary_r30mm"], "kinematics.rotary_radius_mm": 20.0})

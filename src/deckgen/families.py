@@ -414,7 +414,8 @@ def linear_ccs() -> list[CaseDef]:
             data = _cutting(name, rock, packing, bonds, contact, block, _ccs_cutter(f, scale), kin, outputs)
             if scale == "full":
                 data["run"] = {"max_steps": _max_steps(data)}
-            ridge = ridge_width_mm(S, p, CCS_TIP_WIDTH_MM * f, 20.0)
+            cutter = data["cutter"]
+            ridge = ridge_width_mm(S, p, cutter["tip_width_mm"], cutter["flank_angle_deg"])
             factors = {"rock": rock, "penetration_full_mm": p_full, "penetration_mm": p, "disc_diameter_mm": _r(CCS_D_MM * f),
                        "spacing_full_mm": S_full, "spacing_mm": S, "geometry_factor_1": _r(f, 4), "penetration_factor_1": fp,
                        "ridge_width_mm": _r(ridge, 3),
@@ -734,7 +735,12 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
             row["lateral_to_normal_ratio_1"] = float("nan")
         rows.append({"case": s["case"], **row})
     runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1"])
-    runs = runs.drop(columns=[c for c in runs.columns if c in idx.columns and c != "case"])  # the index's factor wins
+    return _with_index_factors(idx, runs)
+
+
+def _with_index_factors(idx: "Any", runs: "Any") -> "Any":
+    """Rows of ``runs`` joined to their case's row of index.csv; the index's factor columns win."""
+    runs = runs.drop(columns=[c for c in runs.columns if c in idx.columns and c != "case"])
     return idx.merge(runs, on="case", how="inner")
 
 
@@ -962,8 +968,7 @@ def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None
     unknown = sorted(set(table["case"]) - set(idx["case"]))
     if unknown:
         raise ValueError(f"{index_csv}: no row for the cases {', '.join(unknown)} (fix: the family's index.csv)")
-    runs = table.drop(columns=[c for c in table.columns if c in idx.columns and c != "case"])
-    return idx.merge(runs, on="case", how="inner")
+    return _with_index_factors(idx, table)
 
 
 def report_table(family: str, table: "Any", out: str | Path) -> Path:

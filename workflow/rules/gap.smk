@@ -2,8 +2,8 @@
 #   snakemake results/gap/<name>/report.json   for a study listed under `gap:` in the config
 #       (gap: {<name>: {measured: CSV, base: CASE, backend: fast|dem}})
 #   snakemake results/gap/seed002_demo/report.json   real data: seed 002 RCM forces vs a linear model
-#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc, three candidates (slow; 3 packing
-#       seeds for the measured rows and 3 others for every model case)
+#   snakemake results/gap/dem_example/report.json    DEM end to end: a hidden free-rolling disc, three candidates (slow; 5 packing
+#       seeds for the measured rows and 3 others for every model case; 92 engine runs)
 # Engine runs use one rank each, gap_ranks of them at a time (default 1).
 
 GAP = config.get("gap", {})

@@ -4,6 +4,7 @@ DEM evaluation (marked ``engine``)."""
 
 from __future__ import annotations
 
+import json
 import math
 import time
 from pathlib import Path
@@ -402,3 +403,33 @@ def test_tiny_dem_evaluation_and_cache_hit(tmp_path):
                           command=["false"], name="tiny")
     bad = broken.evaluate(p)
     assert bad["ok"] is False and "EngineError" in bad["error"] and math.isnan(bad["ucs_Pa"])
+
+
+@pytest.mark.engine
+@pytest.mark.skipif(not _lmp_ok(), reason="no LAMMPS binary (run `make setup`)")
+def test_specimen_that_did_not_fail_is_run_longer_or_fails_the_point(tmp_path):
+    """A UCS run cut by max_strain before its peak (here 0.002; the tiny cylinder peaks at a strain of
+    0.0035) reports a lower bound, not a strength: the evaluator runs it again at 2.5x the strain, and
+    without that retry the point fails with a message instead of entering the table."""
+    from deckgen.runner import engine_command
+
+    p = MicroParams(10.0, 10.0, 20.0)
+    short = {**TINY_UCS, "max_strain": 0.002}
+    strict = DemEvaluator(TINY_BASE, short, TINY_BTS, tmp_path / "strict", cache=tmp_path / "cache",
+                          command=engine_command(1), name="tiny", extend_attempts=0)
+    bad = strict.evaluate(p)
+    assert bad["ok"] is False and "did not fail before max_strain 0.002" in bad["error"], bad
+    cut = json.loads(next((tmp_path / "strict").rglob("ucs/parsed/summary.json")).read_text())
+    assert cut["peak_reached"] is False and cut["strain_at_peak_1"] > 0.97 * cut["final_strain_1"]
+    assert "no failure" in cut["notes"]
+
+    ev = DemEvaluator(TINY_BASE, short, TINY_BTS, tmp_path / "work", cache=tmp_path / "cache",
+                      command=engine_command(1), name="tiny")
+    out = ev.evaluate(p)
+    assert out["ok"], out["error"]
+    assert ev.engine_runs == 3  # UCS, UCS again at max_strain 0.005, BTS
+    long = json.loads(next((tmp_path / "work").rglob("ucs_long1/parsed/summary.json")).read_text())
+    assert long["peak_reached"] is True and long["post_peak_drop_1"] >= 0.1
+    assert 0.0025 < long["strain_at_peak_1"] < 0.005
+    # the longer run's peak is the strength, above the cut run's lower bound
+    assert out["ucs_Pa"] == pytest.approx(long["peak_stress_Pa"]) and out["ucs_Pa"] > cut["peak_stress_Pa"]

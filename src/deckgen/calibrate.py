@@ -782,7 +782,8 @@ class DemEvaluator:
     def __init__(self, base: dict[str, Any], ucs_specimen: dict[str, Any], bts_specimen: dict[str, Any],
                  work_dir: str | Path, *, cache: str | Path | None = None, command: list[str] | None = None,
                  tie_contact_modulus: bool = True, timeout_s: float | None = None, name: str = "cal",
-                 parallel: bool = False, ucs_packings: int = 1, bts_packings: int = 1) -> None:
+                 parallel: bool = False, ucs_packings: int = 1, bts_packings: int = 1,
+                 extend_attempts: int = 1) -> None:
         self.base = base
         # replicate packings per test: the point's value is their mean (packing scatter of a coarse
         # Brazilian disc is ~12 %, more than the tolerance; docs/calibration.md)
@@ -796,6 +797,9 @@ class DemEvaluator:
         self.timeout_s = timeout_s
         self.name = name.replace("_", "-")
         self.engine_runs = 0  # engine runs started by this object (UCS + BTS; packings not counted)
+        # a test that reaches max_strain before failing is run again with EXTEND_FACTOR x the strain,
+        # this many times, before the point counts as failed
+        self.extend_attempts = extend_attempts
         # points live under work_dir/<setup key>/<params key>: a changed base case or specimen
         # (resolution, speed, packing seed) never answers from another setup's runs
         setup = {"base": base, "ucs": self.ucs_specimen, "bts": self.bts_specimen, "tie": tie_contact_modulus}
@@ -806,8 +810,11 @@ class DemEvaluator:
         """Run folder of a point: ``work_dir/<setup key>/<params key>``."""
         return self.work_dir / self.setup_key / params.key()
 
-    def case(self, params: MicroParams, test: Literal["ucs", "bts"], replicate: int = 0) -> Case:
+    def case(self, params: MicroParams, test: Literal["ucs", "bts"], replicate: int = 0,
+             max_strain: float | None = None) -> Case:
         sp = self.ucs_specimen if test == "ucs" else self.bts_specimen
+        if max_strain is not None:
+            sp = {**sp, "max_strain": max_strain}
         data = deep_merge(deep_merge(self.base, params.overrides(self.tie)), {"specimen": sp})
         data = deep_merge({"name": f"{self.name}-{test}"}, data)
         case = Case.model_validate(data)
@@ -829,17 +836,35 @@ class DemEvaluator:
         from deckgen.results import parse_run
         from deckgen.runner import run_deck
 
-        sub = folder / (test if replicate == 0 else f"{test}_r{replicate}")
-        summary = sub / "parsed" / "summary.json"
-        if summary.is_file():
-            return json.loads(summary.read_text())
-        run_dir = sub / "run"
-        spec = render_case(self.case(params, test, replicate), run_dir, cache=self.cache, progress=False,
-                           command=self.command)
-        self.engine_runs += 1
-        run_deck(run_dir, expected_steps=spec["derived"]["expected_steps"], command=self.command,
-                 progress=False, timeout_s=self.timeout_s)
-        return parse_run(run_dir, sub / "parsed")
+        from deckgen.results import peak_reached
+
+        name = test if replicate == 0 else f"{test}_r{replicate}"
+        max_strain: float | None = None
+        for attempt in range(1 + self.extend_attempts):
+            sub = folder / (name if attempt == 0 else f"{name}_long{attempt}")
+            summary = sub / "parsed" / "summary.json"
+            if summary.is_file():
+                out = json.loads(summary.read_text())
+            else:
+                run_dir = sub / "run"
+                case = self.case(params, test, replicate, max_strain)
+                spec = render_case(case, run_dir, cache=self.cache, progress=False, command=self.command)
+                self.engine_runs += 1
+                run_deck(run_dir, expected_steps=spec["derived"]["expected_steps"], command=self.command,
+                         progress=False, timeout_s=self.timeout_s)
+                out = parse_run(run_dir, sub / "parsed")
+            if peak_reached(out):
+                return out
+            # the specimen had not failed when the run reached max_strain: its peak is a lower bound of
+            # the strength (a strong point far from the targets); run it again, longer
+            sp = self.ucs_specimen if test == "ucs" else self.bts_specimen
+            current = max_strain if max_strain is not None else _specimen_max_strain(test, sp)
+            if current >= MAX_STRAIN_CAP:
+                break
+            max_strain = float(f"{min(MAX_STRAIN_CAP, EXTEND_FACTOR * current):.4g}")
+        raise ValueError(f"{test} specimen ({name}) did not fail before max_strain "
+                         f"{out.get('final_strain_1', float('nan')):.4g} (peak at strain {out.get('strain_at_peak_1', float('nan')):.4g}): "
+                         f"its peak is a lower bound, not a strength ({sub})")
 
     def evaluate(self, params: MicroParams) -> dict[str, Any]:
         from deckgen.parse import ParseError
@@ -882,6 +907,17 @@ class DemEvaluator:
         if not out["ok"]:
             failed.write_text(json.dumps({**out, "engine_runs": 0}, indent=2) + "\n")
         return out
+
+
+#: Longer re-runs of specimens that had not failed at max_strain (DemEvaluator): factor and upper bound.
+EXTEND_FACTOR = 2.5
+MAX_STRAIN_CAP = 0.2
+
+
+def _specimen_max_strain(test: str, specimen: dict[str, Any]) -> float:
+    if "max_strain" in specimen:
+        return float(specimen["max_strain"])
+    return float(UcsCylinder().max_strain if test == "ucs" else BrazilianDisc().max_strain)
 
 
 def _num(v: Any) -> float:

@@ -108,6 +108,14 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("t100c16 + E_c/E_b 1", {"twisting_strength_factor": 100.0, "clump_size": 16, "contact_modulus_ratio": 1.0}),
     ("twisting x10 + clumps of 16 + tau/sigma=0.5", {"twisting_strength_factor": 10.0, "clump_size": 16,
                                                     "shear_strength_MPa": 30.0}),
+    # with clumps a lower tau/sigma lowered UCS/BTS (5.1 at 0.5, 4.5 at 0.25): the other way, lower sigma_c at
+    # tau_c 60 MPa; and both strengths halved (the failure strain axis, at constant tau/sigma)
+    ("t100c16 + sigma_c 30 (tau/sigma 2)", {"twisting_strength_factor": 100.0, "clump_size": 16,
+                                            "tensile_strength_MPa": 30.0}),
+    ("t100c16 + sigma_c 15 (tau/sigma 4)", {"twisting_strength_factor": 100.0, "clump_size": 16,
+                                            "tensile_strength_MPa": 15.0}),
+    ("t100c16 + sigma_c = tau_c = 30 (sigma_c/E_b 1.5e-3)", {"twisting_strength_factor": 100.0, "clump_size": 16,
+                                                             "tensile_strength_MPa": 30.0, "shear_strength_MPa": 30.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -88,7 +88,7 @@ __all__ = [
 UNITLESS_COLUMNS = frozenset({
     "chip", "chips_count", "chips_grains", "debris_grains", "body_grains", "largest_chip_grains",
     "case", "engine", "test", "mode", "step", "id", "id1", "id2", "btype", "sample_step",
-    "bonds_intact", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
+    "bonds_intact", "peak_reached", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
     "n_grains_bonded", "n_grains_missing_final", "grains_inside_cutter_final", "steps", "final_step", "damage_step",
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series",
@@ -143,7 +143,8 @@ PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
     "bonds_broken_at_peak", "youngs_modulus_Pa", "secant_modulus_Pa", "modulus_fit_points",
     "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa", "modulus_fit_stress_hi_Pa",
-    "final_strain_1", "area_m2", "height_m", "platen_speed_m_s", "poisson_ratio_1",
+    "final_strain_1", "post_peak_drop_1", "peak_reached", "area_m2", "height_m", "platen_speed_m_s",
+    "poisson_ratio_1",
 ]
 CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "peak")
@@ -177,6 +178,12 @@ _CUTTING_RENAME = {
 CONTACT_THRESHOLD_N = 1e-9
 #: Pre-peak window of the modulus fit, as fractions of the peak stress.
 MODULUS_WINDOW = (0.2, 0.5)
+#: A platen test has failed (its peak is a strength, not the stress where the run stopped) when the
+#: stress at the last sample is at least this fraction below the peak and the peak lies before this
+#: fraction of the final strain. The stop rules end runs at 20-80 % below the peak; a run cut by
+#: ``max_strain`` before the peak ends at or near its maximum.
+PEAK_DROP_MIN = 0.1
+PEAK_STRAIN_MAX_FRACTION = 0.97
 
 _PLATEN_TESTS = ("ucs", "bts")
 
@@ -554,7 +561,9 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         out.update({k: _nan() for k in ("peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
                                          "bonds_broken_at_peak", modulus_key, "modulus_fit_points",
                                          "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa",
-                                         "modulus_fit_stress_hi_Pa", "final_strain_1", "poisson_ratio_1")})
+                                         "modulus_fit_stress_hi_Pa", "final_strain_1", "poisson_ratio_1",
+                                         "post_peak_drop_1")})
+        out["peak_reached"] = False
         return out
     stress = ts["stress_Pa"].to_numpy()
     strain = ts["strain_1"].to_numpy()
@@ -583,7 +592,27 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         "modulus_fit_stress_lo_Pa": lo, "modulus_fit_stress_hi_Pa": hi,
         "final_strain_1": float(strain[-1]),
     })
+    out["post_peak_drop_1"] = float(1.0 - stress[-1] / peak) if peak > 0 else _nan()
+    out["peak_reached"] = peak_reached(out)
     return out
+
+
+def peak_reached(summary: dict[str, Any]) -> bool:
+    """Did the platen test fail, i.e. is ``peak_stress_Pa`` a strength? (:data:`PEAK_DROP_MIN`).
+
+    Works on summaries written before ``post_peak_drop_1`` existed: then only the strain criterion
+    (peak before 97 % of the final strain) is applied."""
+    def num(k: str) -> float:
+        try:
+            return float(summary.get(k))  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            return _nan()
+    peak_eps, final_eps, drop = num("strain_at_peak_1"), num("final_strain_1"), num("post_peak_drop_1")
+    if not (math.isfinite(peak_eps) and math.isfinite(final_eps)) or final_eps <= 0:
+        return False
+    if peak_eps >= PEAK_STRAIN_MAX_FRACTION * final_eps:
+        return False
+    return bool(drop >= PEAK_DROP_MIN) if math.isfinite(drop) else True
 
 
 def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int | None:
@@ -765,6 +794,10 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
     }
     if test in _PLATEN_TESTS:
         summary.update(_platen_summary(ts, spec, test))
+        if not ts.empty and not summary["peak_reached"]:
+            state.notes.append(f"no failure: the stress at the last sample is {100 * summary['post_peak_drop_1']:.0f} % below "
+                               f"the peak (strain at peak {summary['strain_at_peak_1']:.4g} of {summary['final_strain_1']:.4g}); "
+                               f"peak_stress_Pa is a lower bound, not a strength (fix: raise specimen.max_strain)")
     else:
         extra = _cutting_summary(ts, spec)
         note = extra.pop("notes_extra", None)

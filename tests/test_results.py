@@ -464,3 +464,28 @@ def test_corrupt_gzip_is_not_swallowed(tmp_path):
     (run / "broken.dump.gz").write_bytes(bytes(data))
     with pytest.raises(ParseError, match=r"broken\.dump\.gz:\d+: corrupt gzip"):
         parse_run(run, tmp_path / "out")
+
+
+def test_peak_reached_tells_failure_from_a_run_cut_by_max_strain():
+    from deckgen.results import peak_reached
+
+    base = {"strain_at_peak_1": 0.0077, "final_strain_1": 0.0079, "max_strain_1": 0.0429}
+    # brittle: the load fell by 31 % within two samples of the peak and the stop rule ended the run
+    assert peak_reached({**base, "post_peak_drop_1": 0.31})
+    # the run went to max_strain: peak at the last sample, or on a dip just after the maximum
+    cut = {"strain_at_peak_1": 0.0429, "final_strain_1": 0.0429, "max_strain_1": 0.0429}
+    assert not peak_reached({**cut, "post_peak_drop_1": 0.0})
+    assert not peak_reached({**cut, "strain_at_peak_1": 0.0425, "post_peak_drop_1": 0.15})
+    # a peak well before the end that the load has left by 24 % is a failure; by 2 % it is not
+    early = {"strain_at_peak_1": 0.0409, "final_strain_1": 0.0419, "max_strain_1": 0.0429}
+    assert peak_reached({**early, "strain_at_peak_1": 0.030, "post_peak_drop_1": 0.24})
+    assert not peak_reached({**early, "strain_at_peak_1": 0.030, "post_peak_drop_1": 0.02})
+    # summaries from before the drop column: strain criterion only; empty series: no
+    assert peak_reached({"strain_at_peak_1": 0.005, "final_strain_1": 0.007})
+    assert not peak_reached({"strain_at_peak_1": 0.0172, "final_strain_1": 0.0172})
+    assert not peak_reached({"strain_at_peak_1": float("nan"), "final_strain_1": float("nan")})
+
+
+def test_reference_ucs_run_failed(parsed):
+    s, _ = parsed["ref_ucs"]
+    assert s["peak_reached"] is True and s["post_peak_drop_1"] >= 0.1 and s["max_strain_1"] > s["final_strain_1"]

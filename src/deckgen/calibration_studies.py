@@ -116,6 +116,11 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
                                             "tensile_strength_MPa": 15.0}),
     ("t100c16 + sigma_c = tau_c = 30 (sigma_c/E_b 1.5e-3)", {"twisting_strength_factor": 100.0, "clump_size": 16,
                                                              "tensile_strength_MPa": 30.0, "shear_strength_MPa": 30.0}),
+    # twisting x10 and x100 with clumps of 16 did not fail in compression within 4 % strain: the twisting
+    # factor between 1 (clumps of 16: fails at 1.0 %) and 10
+    ("c16 + twisting x2", {"twisting_strength_factor": 2.0, "clump_size": 16}),
+    ("c16 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 16}),
+    ("c16 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 16}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -143,7 +143,7 @@ PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "peak_stress_Pa", "strain_at_peak_1", "time_at_peak_s", "peak_force_N",
     "bonds_broken_at_peak", "youngs_modulus_Pa", "secant_modulus_Pa", "modulus_fit_points",
     "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa", "modulus_fit_stress_hi_Pa",
-    "final_strain_1", "post_peak_drop_1", "peak_reached", "area_m2", "height_m", "platen_speed_m_s",
+    "final_strain_1", "max_strain_1", "post_peak_drop_1", "peak_reached", "area_m2", "height_m", "platen_speed_m_s",
     "poisson_ratio_1",
 ]
 CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
@@ -184,6 +184,9 @@ MODULUS_WINDOW = (0.2, 0.5)
 #: ``max_strain`` before the peak ends at or near its maximum.
 PEAK_DROP_MIN = 0.1
 PEAK_STRAIN_MAX_FRACTION = 0.97
+#: ... or when the run ended below this fraction of its ``max_strain`` (the stop rule fired; a run that
+#: reaches max_strain ends at or just above it).
+STOPPED_EARLY_FRACTION = 0.99
 
 _PLATEN_TESTS = ("ucs", "bts")
 
@@ -562,7 +565,7 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
                                          "bonds_broken_at_peak", modulus_key, "modulus_fit_points",
                                          "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa",
                                          "modulus_fit_stress_hi_Pa", "final_strain_1", "poisson_ratio_1",
-                                         "post_peak_drop_1")})
+                                         "post_peak_drop_1", "max_strain_1")})
         out["peak_reached"] = False
         return out
     stress = ts["stress_Pa"].to_numpy()
@@ -593,26 +596,33 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
         "final_strain_1": float(strain[-1]),
     })
     out["post_peak_drop_1"] = float(1.0 - stress[-1] / peak) if peak > 0 else _nan()
+    out["max_strain_1"] = float(spec.get("case", {}).get("specimen", {}).get("max_strain") or _nan())
     out["peak_reached"] = peak_reached(out)
     return out
 
 
 def peak_reached(summary: dict[str, Any]) -> bool:
-    """Did the platen test fail, i.e. is ``peak_stress_Pa`` a strength? (:data:`PEAK_DROP_MIN`).
+    """Did the platen test fail, i.e. is ``peak_stress_Pa`` a strength?
 
-    Works on summaries written before ``post_peak_drop_1`` existed: then only the strain criterion
-    (peak before 97 % of the final strain) is applied."""
+    Yes when the stress at the last sample is :data:`PEAK_DROP_MIN` or more below the peak and either
+    the run stopped before its ``max_strain`` (the stop rule fired: a brittle specimen may lose its
+    load within a few samples of the peak) or the peak lies before 97 % of the final strain. A run
+    cut by ``max_strain`` whose last sample happens to sit on a dip just after the maximum is not a
+    failure. Summaries written before ``post_peak_drop_1`` existed get the strain criterion only."""
     def num(k: str) -> float:
         try:
             return float(summary.get(k))  # type: ignore[arg-type]
         except (TypeError, ValueError):
             return _nan()
     peak_eps, final_eps, drop = num("strain_at_peak_1"), num("final_strain_1"), num("post_peak_drop_1")
+    max_eps = num("max_strain_1")
     if not (math.isfinite(peak_eps) and math.isfinite(final_eps)) or final_eps <= 0:
         return False
-    if peak_eps >= PEAK_STRAIN_MAX_FRACTION * final_eps:
-        return False
-    return bool(drop >= PEAK_DROP_MIN) if math.isfinite(drop) else True
+    peak_early = peak_eps < PEAK_STRAIN_MAX_FRACTION * final_eps
+    if not math.isfinite(drop):
+        return bool(peak_early)
+    stopped_early = math.isfinite(max_eps) and final_eps < STOPPED_EARLY_FRACTION * max_eps
+    return bool(drop >= PEAK_DROP_MIN and (stopped_early or peak_early))
 
 
 def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int | None:

@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 110 + 2 * len(NAMES)  # 110 case files + index.csv and README.md per family
+    assert len(files) == 114 + 2 * len(NAMES)  # 114 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -52,7 +52,7 @@ def test_case_counts_per_family():
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
-        ("odc", "full"): 10, ("odc", "reduced"): 12,  # 9 of Table 5.1 + 3 supplementary
+        ("odc", "full"): 10, ("odc", "reduced"): 16,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts
     }
 
 
@@ -67,7 +67,10 @@ def test_every_family_case_validates_and_its_path_fits_the_block(family, scale):
         cutter_path(case, case.cutter.diameter_mm * MM / 2)
         est = fam.estimate(case.model_dump())
         assert est["steps_est"] < case.run.max_steps, path
-        if scale == "reduced":
+        if scale == "reduced" and path.stem.endswith("_long"):  # the supplementary long ODC cuts: 3.7x the travel
+            assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 600_000, (path, est)
+            assert est["particle_steps_est"] <= 2e9, (path, est)  # <= ~17 min at 2 M particle-steps/s
+        elif scale == "reduced":
             assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 400_000, (path, est)
             assert est["particle_steps_est"] <= 8e8, (path, est)  # <= ~7 min at 2 M particle-steps/s
 
@@ -185,7 +188,7 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
             assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(4 * v), pytest.approx(4 * f))
             assert c.kinematics.eccentricity_mm == pytest.approx(10 * e)
             continue
-        f = fulls[c.name.replace("_red_", "_")]
+        f = fulls[c.name.replace("_red_", "_").removesuffix("_long")]
         assert c.kinematics.speed_m_s == pytest.approx(4 * f.kinematics.speed_m_s)
         assert c.kinematics.frequency_hz == pytest.approx(4 * f.kinematics.frequency_hz)
         assert c.kinematics.eccentricity_mm == f.kinematics.eccentricity_mm
@@ -448,3 +451,31 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     for names in fam.TREND_SUBSETS.values():
         for name in names:
             assert f"{name}/run/in.deck" in text
+
+
+def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_trends():
+    cases = {c.name: c for c in fam.odc()}
+    longs = [cases[f"odc_red_s{sim}_long"] for sim in fam.ODC_LONG_SIMS]
+    for c in longs:
+        kin, short = c.data["kinematics"], cases[c.name.removesuffix("_long")].data
+        assert kin["travel_mm"] == 44 and c.data["specimen"]["length_mm"] == 58
+        assert c.data["outputs"]["steady_window"] == [0.25, 0.95]
+        # the same cut as the 12 mm case apart from travel, block length and window
+        same = {k: v for k, v in kin.items() if k != "travel_mm"}
+        assert same == {k: v for k, v in short["kinematics"].items() if k != "travel_mm"}
+        if kin["mode"] == "oscillation":
+            cycles = 0.7 * kin["travel_mm"] * 1e-3 * kin["frequency_hz"] / kin["speed_m_s"]
+            assert cycles == pytest.approx(1.386, abs=0.01)
+    # the frequency trends take the 12 mm cuts only; the long ones feed f_rises_with_nu_long
+    import pandas as pd
+
+    rows = []
+    for name, f, nu, force in [("a_long", 90, 0.884, 2.0), ("b_long", 90, 1.768, 9.0), ("c_long", 90, 3.537, 12.0),
+                                       ("d", 180, 0.44, 30.0), ("e", 240, 0.33, 20.0)]:
+        rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
+                     "eccentricity_ratio_1": 0.4, "speed_full_m_s": 0.5, "cycles_in_window_1": 1.0,
+                     "force_magnitude_N_mean_steady": force})
+    t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")
+    assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2
+    up = t.loc["f_rises_with_nu_long"]
+    assert up["runs"] == 3 and up["slope"] > 0 and up["sign_as_seed"]

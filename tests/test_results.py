@@ -479,7 +479,9 @@ def test_peak_reached_tells_failure_from_a_run_cut_by_max_strain():
     # a peak well before the end that the load has left by 24 % is a failure; by 2 % it is not
     early = {"strain_at_peak_1": 0.0409, "final_strain_1": 0.0419, "max_strain_1": 0.0429}
     assert peak_reached({**early, "strain_at_peak_1": 0.030, "post_peak_drop_1": 0.24})
-    assert not peak_reached({**early, "strain_at_peak_1": 0.030, "post_peak_drop_1": 0.02})
+    assert not peak_reached({**early, "strain_at_peak_1": 0.039, "post_peak_drop_1": 0.02})
+    # a split Brazilian disc: peak at 55 % of the run, the halves keep 91 % of the load to the end
+    assert peak_reached({"strain_at_peak_1": 0.011, "final_strain_1": 0.020, "max_strain_1": 0.02, "post_peak_drop_1": 0.087})
     # summaries from before the drop column: strain criterion only; empty series: no
     assert peak_reached({"strain_at_peak_1": 0.005, "final_strain_1": 0.007})
     assert not peak_reached({"strain_at_peak_1": 0.0172, "final_strain_1": 0.0172})

@@ -513,6 +513,14 @@ SEED003_SIMS = (
 ODC_SUPPLEMENTARY = ((101, 0.1, 45.0, 0.5, 9), (102, 0.1, 60.0, 0.5, 9), (103, 0.1, 67.5, 0.5, 9))
 ODC_R_MM = 10.0
 ODC_SPEEDUP = 4.0  # reduced scale: forward speed and frequency x4 (nu = V/(e w) unchanged)
+#: Supplementary long reduced cuts (names ``odc_red_s<sim>_long``): the straight cut and seed 003's eccentricity
+#: series at 22.5 rev/s (nu 0.88, 1.77, 3.54) over 44 mm of travel with the steady window 25-95 % of it
+#: (30.8 mm: 1.39 cycles at 90 Hz, against 0.27 in the 12 mm cuts), so the means average over whole cycles.
+#: They separate the short window from the other candidate causes (speed-up, softened bonds) of the
+#: reduced runs' force drop at nu > 1 (docs/families.md).
+ODC_LONG_SIMS = (10, 11, 15, 16)
+ODC_LONG_TRAVEL_MM = 44
+ODC_LONG_WINDOW = (0.25, 0.95)
 
 
 def odc() -> list[CaseDef]:
@@ -520,7 +528,10 @@ def odc() -> list[CaseDef]:
     rock = "savonniere_limestone"
     out: list[CaseDef] = []
     for scale in SCALES:
-        for sim, ecc, rev_s, V, clr in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ()):
+        runs = [(row, False) for row in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ())]
+        if scale == "reduced":
+            runs += [(row, True) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
+        for (sim, ecc, rev_s, V, clr), long in runs:
             if scale == "reduced" and sim == 19:
                 continue  # 4.5 rev/s at 0.1 m/s: < 0.3 cycles in a reduced block (docs/families.md)
             e_mm = _r(ecc * ODC_R_MM, 3)
@@ -528,7 +539,7 @@ def odc() -> list[CaseDef]:
             nu = V / (e_mm * 1e-3 * 2 * math.pi * rev_s) if osc else math.inf
             k = 1.0 if scale == "full" else ODC_SPEEDUP
             speed, freq = _r(V * k), _r(rev_s * k)
-            name = f"odc_{'full' if scale == 'full' else 'red'}_s{sim}"
+            name = f"odc_{'full' if scale == 'full' else 'red'}_s{sim}" + ("_long" if long else "")
             kin: dict[str, Any] = {"mode": "oscillation" if osc else "linear", "speed_m_s": speed, "penetration_mm": 4}
             if osc:
                 kin.update(eccentricity_mm=e_mm, frequency_hz=freq, spin="shaft")
@@ -549,14 +560,21 @@ def odc() -> list[CaseDef]:
                     *bond_lines,
                 ]
             else:
-                travel = 12 if V >= 0.5 else 6
+                travel = ODC_LONG_TRAVEL_MM if long else (12 if V >= 0.5 else 6)
                 L, W, H = travel + 14, 24, 10
                 kin.update(travel_mm=travel, start_clearance_mm=0.3)
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
                 outputs = {"series_every": 100, "bond_state_every": 5000}
+                if long:
+                    outputs["steady_window"] = list(ODC_LONG_WINDOW)
                 what = (f"Table 5.1 sim {sim}." if sim < 100 else
                         f"supplementary case {sim} (not in Table 5.1): a nu > 1 frequency series beside sims 12-14.")
+                if long:
+                    what = (f"Table 5.1 sim {sim}, supplementary LONG cut: {travel} mm of travel, steady window "
+                            f"{ODC_LONG_WINDOW[0]:g}-{ODC_LONG_WINDOW[1]:g} of it")
+                cycles = travel * freq / (speed * 1e3)
+                window_cycles = ((ODC_LONG_WINDOW[1] - ODC_LONG_WINDOW[0]) if long else 0.5) * cycles
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): {what}",
                     f"Geometry factor 1 for the disc (cone 20/10 mm, rake 30, clearance {clr} deg), depth 4 mm and e = {e_mm} mm",
@@ -564,8 +582,9 @@ def odc() -> list[CaseDef]:
                     f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
                     + (f" = {nu:.2f} and" if osc else " and"),
                     "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress",
-                    "rho*c*v 4x) and only " + (f"{travel * freq / (speed * 1e3):.2f} cycles" if osc else "a linear cut")
-                    + " fit in the travel.",
+                    "rho*c*v 4x) and " + (f"{cycles:.2f} cycles fit in the travel ({window_cycles:.2f} in the steady window)."
+                                          if long and osc else
+                                          "only " + (f"{cycles:.2f} cycles" if osc else "a linear cut") + " fit in the travel."),
                     *bond_lines,
                 ]
             contact = {**contact, "cutter_friction": 0.3}
@@ -578,7 +597,8 @@ def odc() -> list[CaseDef]:
             out.append(CaseDef(fam, scale, name, header, data, {
                 "rock": rock, "seed_sim": sim, "eccentricity_ratio_1": ecc, "eccentricity_mm": e_mm,
                 "frequency_full_hz": rev_s, "frequency_hz": freq, "speed_full_m_s": V, "speed_m_s": speed,
-                "clearance_angle_deg": clr, "velocity_ratio_nu_1": _r(nu, 3) if osc else "inf"}))
+                "clearance_angle_deg": clr, "velocity_ratio_nu_1": _r(nu, 3) if osc else "inf",
+                "travel_mm": kin["travel_mm"]}))
     return out
 
 
@@ -808,19 +828,25 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1,
               "seed 003 Table 5.1, e/R 0.4, 0.5 m/s: 636 N at 22.5 rev/s -> 442.3 N at 67.5 rev/s (the thesis "
-              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0"),
+              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and not case.str.endswith('_long')"),
         Trend("f_falls_with_freq_nu_lt_1_half_cycle", "the same, only runs whose steady window holds at least half an "
               "oscillation cycle (a mean over a fraction of a cycle depends on the phase)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
-              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
+              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long')"),
         Trend("f_flat_with_freq_nu_gt_1", "no fall of the mean force with frequency when nu > 1 (no backward motion; "
               "supplementary runs 101-103, at least half a cycle in the window)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), 0, 0.0,
               "seed 003 sec. 5.4.3: the force 'only decreases when backwards movement exist[s]'; without it (e/R 0.1, 0.2 "
               "at 22.5 rev/s, nu 3.5, 1.8) the mean force is 735 and 754 N against 712 N without oscillation (taken as "
               "no change)", x_range=(45, 67.5),
-              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5"),
+              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long')"),
+        Trend("f_rises_with_nu_long", "at one frequency, the mean force rises from nu < 1 (backward motion) to nu > 1 "
+              "(long cuts, 1.39 cycles in the window)", "force_magnitude_N_mean_steady", "velocity_ratio_nu_1", (), +1,
+              735.0 / 636.0 - 1,
+              "seed 003 sec. 5.4.2-5.4.3, 22.5 rev/s, 0.5 m/s: 636 N at e/R 0.4 (nu 0.88) -> 754 and 735 N at e/R 0.2 and "
+              "0.1 (nu 1.77, 3.54); 712 N without oscillation", x_range=(0.884, 3.537), log_x=True,
+              only="case.str.endswith('_long') and frequency_hz > 0"),
     ),
 }
 
@@ -846,7 +872,7 @@ def trend_table(family: str, table: "Any") -> "Any":
         t = table
         if tr.only:
             try:
-                t = t.query(tr.only)
+                t = t.query(tr.only, engine="python")  # python: the filters use str methods on case names
             except (KeyError, pd.errors.UndefinedVariableError):  # a table without the column (older runs)
                 t = t.iloc[0:0]
         t = t.dropna(subset=[tr.x, tr.y])

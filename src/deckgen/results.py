@@ -187,6 +187,9 @@ PEAK_STRAIN_MAX_FRACTION = 0.97
 #: ... or when the run ended below this fraction of its ``max_strain`` (the stop rule fired; a run that
 #: reaches max_strain ends at or just above it).
 STOPPED_EARLY_FRACTION = 0.99
+#: A peak before this fraction of the final strain is a failure whatever the drop: the load never came
+#: back to it over the last 10 % of the run (a split Brazilian disc whose halves keep some jaw load).
+PEAK_CLEARLY_EARLY_FRACTION = 0.9
 
 _PLATEN_TESTS = ("ucs", "bts")
 
@@ -604,7 +607,8 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
 def peak_reached(summary: dict[str, Any]) -> bool:
     """Did the platen test fail, i.e. is ``peak_stress_Pa`` a strength?
 
-    Yes when the stress at the last sample is :data:`PEAK_DROP_MIN` or more below the peak and either
+    Yes when the peak lies before 90 % of the final strain, or when the stress at the last sample is
+    :data:`PEAK_DROP_MIN` or more below the peak and either
     the run stopped before its ``max_strain`` (the stop rule fired: a brittle specimen may lose its
     load within a few samples of the peak) or the peak lies before 97 % of the final strain. A run
     cut by ``max_strain`` whose last sample happens to sit on a dip just after the maximum is not a
@@ -619,6 +623,8 @@ def peak_reached(summary: dict[str, Any]) -> bool:
     if not (math.isfinite(peak_eps) and math.isfinite(final_eps)) or final_eps <= 0:
         return False
     peak_early = peak_eps < PEAK_STRAIN_MAX_FRACTION * final_eps
+    if peak_eps < PEAK_CLEARLY_EARLY_FRACTION * final_eps:
+        return True
     if not math.isfinite(drop):
         return bool(peak_early)
     stopped_early = math.isfinite(max_eps) and final_eps < STOPPED_EARLY_FRACTION * max_eps

@@ -446,6 +446,7 @@ def test_specimen_that_did_not_fail_is_run_longer_or_fails_the_point(tmp_path):
     out = ev.evaluate(p)
     assert out["ok"], out["error"]
     assert ev.engine_runs == 3  # UCS, UCS again at max_strain 0.005, BTS
+    assert ev.used_folder(p, "ucs").name == "ucs_long1" and ev.used_folder(p, "bts").name == "bts"
     long = json.loads(next((tmp_path / "work").rglob("ucs_long1/parsed/summary.json")).read_text())
     assert long["peak_reached"] is True and long["post_peak_drop_1"] >= 0.1
     assert 0.0025 < long["strain_at_peak_1"] < 0.005

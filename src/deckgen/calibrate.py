@@ -832,6 +832,24 @@ class DemEvaluator:
             case = Case.model_validate(deep_merge(data, {"packing": {"seed": seed}}))
         return case
 
+    def used_folder(self, params: MicroParams, test: Literal["ucs", "bts"], replicate: int = 0) -> Path:
+        """The test's folder whose result the point's value uses: the first attempt that failed the specimen
+        (``<test>``, then ``<test>_long1`` ...), else the last attempt on disk."""
+        from deckgen.results import peak_reached
+
+        name = test if replicate == 0 else f"{test}_r{replicate}"
+        folder = self.folder(params)
+        last = folder / name
+        for attempt in range(1 + self.extend_attempts):
+            sub = folder / (name if attempt == 0 else f"{name}_long{attempt}")
+            summary = sub / "parsed" / "summary.json"
+            if not summary.is_file():
+                break
+            last = sub
+            if peak_reached(json.loads(summary.read_text())):
+                return sub
+        return last
+
     def describe(self) -> dict[str, Any]:
         if self._engine is None:
             self._engine = engine_version(self.command)

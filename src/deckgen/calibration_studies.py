@@ -170,15 +170,13 @@ def smoothed_peak(parsed_dir: Path, window_s: float) -> float:
 def _smoothed(ev: DemEvaluator, p: MicroParams, E_Pa: float) -> dict[str, float]:
     """Smoothed peaks (:func:`smoothed_peak`, window = SMOOTH_TRANSITS P-wave transits of the loaded length
     at the measured E) of the UCS and BTS tests of a point, each the mean over its replicate packings."""
-    folder = ev.folder(p)
     out: dict[str, float] = {}
     for test in ("ucs", "bts"):
         case = ev.case(p, test)
         sp = case.specimen
         length = (sp.height_mm if test == "ucs" else sp.diameter_mm) * 1e-3  # type: ignore[union-attr]
         window = SMOOTH_TRANSITS * length / math.sqrt(E_Pa / case.material.density_kg_m3)
-        vals = [smoothed_peak(folder / (test if i == 0 else f"{test}_r{i}") / "parsed", window)
-                for i in range(ev.replicates[test])]
+        vals = [smoothed_peak(ev.used_folder(p, test, i) / "parsed", window) for i in range(ev.replicates[test])]
         out[f"{test}_smoothed_Pa"] = float(np.mean(vals))
         if len(vals) > 1:
             out[f"{test}_smoothed_cv_1"] = float(np.std(vals, ddof=1) / np.mean(vals))
@@ -191,9 +189,8 @@ SMOOTH_TRANSITS = 3.0
 
 
 def _summaries(ev: DemEvaluator, p: MicroParams) -> tuple[dict[str, Any], dict[str, Any]]:
-    folder = ev.folder(p)
-    return (json.loads((folder / "ucs" / "parsed" / "summary.json").read_text()),
-            json.loads((folder / "bts" / "parsed" / "summary.json").read_text()))
+    return (json.loads((ev.used_folder(p, "ucs") / "parsed" / "summary.json").read_text()),
+            json.loads((ev.used_folder(p, "bts") / "parsed" / "summary.json").read_text()))
 
 
 def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
@@ -207,6 +204,7 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
         row.update({
             "poisson_ratio_1": u.get("poisson_ratio_1", math.nan),
             "ucs_strain_at_peak_1": u.get("strain_at_peak_1"), "bts_strain_at_peak_1": b.get("strain_at_peak_1"),
+            "ucs_max_strain_1": u.get("max_strain_1"), "bts_max_strain_1": b.get("max_strain_1"),
             "ucs_broken_tension": u.get("bonds_broken_tension"), "ucs_broken_shear": u.get("bonds_broken_shear"),
             "bts_broken_tension": b.get("bonds_broken_tension"), "bts_broken_shear": b.get("bonds_broken_shear"),
             "ucs_grains": u.get("n_grains"), "bts_grains": b.get("n_grains"),
@@ -216,15 +214,15 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
         })
         row.update(_smoothed(ev, p, r["E_Pa"]))
         if ev.replicates["bts"] > 1:
-            vals = [json.loads((ev.folder(p) / (f"bts_r{i}" if i else "bts") / "parsed" / "summary.json").read_text())
-                    ["peak_stress_Pa"] for i in range(ev.replicates["bts"])]
+            vals = [json.loads((ev.used_folder(p, "bts", i) / "parsed" / "summary.json").read_text())["peak_stress_Pa"]
+                    for i in range(ev.replicates["bts"])]
             row["bts_cv_1"] = float(np.std(vals, ddof=1) / np.mean(vals))
         if p.clump_size > 1:  # did the intra-clump bonds hold?
-            folder = ev.folder(p)
             for test in ("ucs", "bts"):
-                c = intra_clump_broken(folder / test / "run", folder / test / "parsed")
+                used = ev.used_folder(p, test)
+                c = intra_clump_broken(used / "run", used / "parsed")
                 row.update({f"{test}_intra_clump_bonds": c["intra_bonds"], f"{test}_broken_intra_clump": c["broken_intra"]})
-                spec = json.loads((folder / test / "run" / "spec.json").read_text())
+                spec = json.loads((used / "run" / "spec.json").read_text())
                 row[f"{test}_clump_sizes"] = json.dumps(spec["derived"]["clumps"]["size_distribution"])
     return row
 

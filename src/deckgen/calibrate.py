@@ -1021,7 +1021,8 @@ class _Stop(Exception):
 
 TABLE_COLUMNS = [
     "eval", "key", "ok", "error", "youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa", "friction",
-    "rolling_friction", "radius_multiplier", "gap_tolerance", "contact_modulus_ratio", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
+    "rolling_friction", "radius_multiplier", "gap_tolerance", "contact_modulus_ratio", "clump_size",
+    *OPTIONAL_BOND_FIELDS, "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
     "bts_error_1", "E_error_1",
     "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]

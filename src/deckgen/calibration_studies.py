@@ -121,6 +121,10 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("c16 + twisting x2", {"twisting_strength_factor": 2.0, "clump_size": 16}),
     ("c16 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 16}),
     ("c16 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 16}),
+    # at twisting x2 (the strongest that fails): tau/sigma 2 (sigma_c 30 at tau_c 60), and both strengths doubled
+    ("c16t2 + sigma_c 30 (tau/sigma 2)", {"twisting_strength_factor": 2.0, "clump_size": 16, "tensile_strength_MPa": 30.0}),
+    ("c16t2 + sigma_c = tau_c = 120 (sigma_c/E_b 6e-3)", {"twisting_strength_factor": 2.0, "clump_size": 16,
+                                                           "tensile_strength_MPa": 120.0, "shear_strength_MPa": 120.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -841,7 +841,7 @@ class DemEvaluator:
         folder = self.folder(params)
         last = folder / name
         for attempt in range(1 + self.extend_attempts):
-            sub = folder / (name if attempt == 0 else f"{name}_long{attempt}")
+            sub = _attempt_dir(folder, name, attempt)
             summary = sub / "parsed" / "summary.json"
             if not summary.is_file():
                 break
@@ -868,7 +868,7 @@ class DemEvaluator:
         name = test if replicate == 0 else f"{test}_r{replicate}"
         max_strain: float | None = None
         for attempt in range(1 + self.extend_attempts):
-            sub = folder / (name if attempt == 0 else f"{name}_long{attempt}")
+            sub = _attempt_dir(folder, name, attempt)
             summary = sub / "parsed" / "summary.json"
             if summary.is_file():
                 out = json.loads(summary.read_text())
@@ -934,6 +934,11 @@ class DemEvaluator:
         if not out["ok"]:
             failed.write_text(json.dumps({**out, "engine_runs": 0}, indent=2) + "\n")
         return out
+
+
+def _attempt_dir(folder: Path, name: str, attempt: int) -> Path:
+    """Folder of a test's attempt: ``<name>`` first, then ``<name>_long1``, ``<name>_long2`` ..."""
+    return folder / (name if attempt == 0 else f"{name}_long{attempt}")
 
 
 #: Longer re-runs of specimens that had not failed at max_strain (DemEvaluator): factor and upper bound.

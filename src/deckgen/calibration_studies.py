@@ -125,6 +125,8 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("c16t2 + sigma_c 30 (tau/sigma 2)", {"twisting_strength_factor": 2.0, "clump_size": 16, "tensile_strength_MPa": 30.0}),
     ("c16t2 + sigma_c = tau_c = 120 (sigma_c/E_b 6e-3)", {"twisting_strength_factor": 2.0, "clump_size": 16,
                                                            "tensile_strength_MPa": 120.0, "shear_strength_MPa": 120.0}),
+    # E from the contacts instead of the bonds (E_c/E_b 4 -> 10) at the failing twisting x2 point: lower UCS/E?
+    ("c16t2 + E_c/E_b 10", {"twisting_strength_factor": 2.0, "clump_size": 16, "contact_modulus_ratio": 10.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

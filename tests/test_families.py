@@ -474,7 +474,7 @@ def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_tren
                                        ("d", 180, 0.44, 30.0), ("e", 240, 0.33, 20.0)]:
         rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
                      "eccentricity_ratio_1": 0.4, "speed_full_m_s": 0.5, "cycles_in_window_1": 1.0,
-                     "force_magnitude_N_mean_steady": force})
+                     "force_magnitude_N_mean_steady": force, "force_magnitude_N_mean_cycles": force})
     t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2
     up = t.loc["f_rises_with_nu_long"]

@@ -491,3 +491,30 @@ def test_peak_reached_tells_failure_from_a_run_cut_by_max_strain():
 def test_reference_ucs_run_failed(parsed):
     s, _ = parsed["ref_ucs"]
     assert s["peak_reached"] is True and s["post_peak_drop_1"] >= 0.1 and s["max_strain_1"] > s["final_strain_1"]
+
+
+def test_whole_cycle_means_remove_the_phase_of_a_partial_cycle_window():
+    """An oscillating force 10 + 5 sin(w t) over 1.39 cycles of window: the steady mean carries the phase of
+    the extra 0.39 cycle, the whole-cycle mean is 10 N (one cycle averaged)."""
+    from deckgen.results import CUTTING_QUANTITIES, _cutting_summary
+
+    f_hz, duration = 90.0, 0.022
+    omega = 2 * np.pi * f_hz
+    t = np.linspace(0.0, duration, 22001)
+    force = 10.0 + 5.0 * np.sin(omega * t + 0.3)
+    ts = pd.DataFrame({"time_s": t, **{q: force for q in CUTTING_QUANTITIES}})
+    spec = {"derived": {"cutter": {"duration": duration, "V": 2.0, "ecc": 0.001, "omega": omega, "radius": 0.01},
+                        "steady_window": [0.25, 0.95], "kinematics_mode": "oscillation"},
+            "case": {"kinematics": {"mode": "oscillation"}, "outputs": {"steady_window": [0.25, 0.95]}}}
+    s = _cutting_summary(ts, spec)
+    assert s["cycles_averaged_1"] == 1  # 0.7 * 0.022 s * 90 Hz = 1.39 cycles
+    assert s["force_magnitude_N_mean_cycles"] == pytest.approx(10.0, abs=0.01)
+    assert abs(s["force_magnitude_N_mean_steady"] - 10.0) > 0.5  # the partial cycle biases the plain mean
+    # no whole cycle in the window: NaN; no oscillation: the steady mean
+    short = {**spec, "derived": {**spec["derived"], "steady_window": [0.4, 0.9]}}
+    s2 = _cutting_summary(ts[ts.time_s <= 0.01], {**short, "derived": {**short["derived"],
+                                                                        "cutter": {**spec["derived"]["cutter"], "duration": 0.01}}})
+    assert s2["cycles_averaged_1"] == 0 and np.isnan(s2["force_magnitude_N_mean_cycles"])
+    lin = {**spec, "derived": {**spec["derived"], "cutter": {**spec["derived"]["cutter"], "ecc": 0.0, "omega": 0.0}}}
+    s3 = _cutting_summary(ts, lin)
+    assert s3["force_magnitude_N_mean_cycles"] == s3["force_magnitude_N_mean_steady"]

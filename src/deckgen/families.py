@@ -722,7 +722,7 @@ EXTRA_PLOTS: dict[str, list[tuple[str, list[str], list[str]]]] = {
 TABLE_FIELDS = [
     "n_grains", "n_bonds_initial", "steps", "dt_s", "wall_s", "particle_steps_per_s", "run_completed",
     "force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
-    "force_magnitude_N_mean_steady", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
+    "force_magnitude_N_mean_steady", "force_magnitude_N_mean_cycles", "cycles_averaged_1", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
     "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
@@ -842,7 +842,8 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "no change)", x_range=(45, 67.5),
               only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long')"),
         Trend("f_rises_with_nu_long", "at one frequency, the mean force rises from nu < 1 (backward motion) to nu > 1 "
-              "(long cuts, 1.39 cycles in the window)", "force_magnitude_N_mean_steady", "velocity_ratio_nu_1", (), +1,
+              "(long cuts; mean over the whole cycle in the window)", "force_magnitude_N_mean_cycles", "velocity_ratio_nu_1",
+              (), +1,
               735.0 / 636.0 - 1,
               "seed 003 sec. 5.4.2-5.4.3, 22.5 rev/s, 0.5 m/s: 636 N at e/R 0.4 (nu 0.88) -> 754 and 735 N at e/R 0.2 and "
               "0.1 (nu 1.77, 3.54); 712 N without oscillation", x_range=(0.884, 3.537), log_x=True,
@@ -875,6 +876,8 @@ def trend_table(family: str, table: "Any") -> "Any":
                 t = t.query(tr.only, engine="python")  # python: the filters use str methods on case names
             except (KeyError, pd.errors.UndefinedVariableError):  # a table without the column (older runs)
                 t = t.iloc[0:0]
+        if tr.x not in t.columns or tr.y not in t.columns:  # a table from before the quantity existed
+            t = t.iloc[0:0].assign(**{tr.x: [], tr.y: []})
         t = t.dropna(subset=[tr.x, tr.y])
         t = t.assign(_x=np.log(t[tr.x]) if tr.log_x else t[tr.x], _y=t[tr.y].abs() if tr.abs_y else t[tr.y])
         t["_g"] = t[list(tr.groups)].astype(str).agg("|".join, axis=1) if tr.groups and len(t) else "all"

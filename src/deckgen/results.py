@@ -100,7 +100,7 @@ UNITLESS_COLUMNS = frozenset({
 UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m3", "_J_m3", "_m_s",
                  "_rad_s", "_per_s")
 #: Statistic suffixes after the unit (``force_normal_N_mean_steady``).
-STAT_SUFFIXES = ("_mean_steady", "_peak")
+STAT_SUFFIXES = ("_mean_steady", "_mean_cycles", "_peak")
 
 
 def has_unit(name: str) -> bool:
@@ -147,8 +147,8 @@ PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "poisson_ratio_1",
 ]
 CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
-    f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "peak")
-] + [
+    f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "mean_cycles", "peak")
+] + ["cycles_averaged_1",
     "contact_fraction_steady_1", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "kinematics_mode", "cut_duration_s", "steady_start_s", "steady_end_s", "steady_rows",
     "cutter_radius_m", "cutter_speed_m_s", "eccentricity_m", "omega_rad_s", "travel_m",
@@ -693,6 +693,21 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
         v = ts[q].to_numpy()
         out[f"{q}_mean_steady"] = float(v[mask].mean()) if mask.any() else _nan()
         out[f"{q}_peak"] = float(v[int(np.argmax(np.abs(v)))]) if len(v) else _nan()
+    # oscillating cuts: means over the whole cycles that fit in the steady window from its start (a mean over
+    # 1.4 cycles weights the phase that is in the window twice); no whole cycle: NaN; no oscillation: the
+    # steady mean
+    n_cycles = 0
+    if ecc > 0 and omega > 0:
+        period = 2 * math.pi / omega
+        n_cycles = int(math.floor((out["steady_end_s"] - out["steady_start_s"]) / period + 1e-9))
+        t = ts["time_s"].to_numpy()
+        cyc = (t >= out["steady_start_s"]) & (t < out["steady_start_s"] + n_cycles * period)
+    out["cycles_averaged_1"] = n_cycles
+    for q in CUTTING_QUANTITIES:
+        if not (ecc > 0 and omega > 0):
+            out[f"{q}_mean_cycles"] = out[f"{q}_mean_steady"]
+        else:
+            out[f"{q}_mean_cycles"] = float(ts[q].to_numpy()[cyc].mean()) if n_cycles >= 1 and cyc.any() else _nan()
     out["contact_fraction_steady_1"] = (float((ts["force_magnitude_N"].to_numpy()[mask] > CONTACT_THRESHOLD_N).mean())
                                         if mask.any() else _nan())
     fn = out["force_normal_N_mean_steady"]
@@ -728,7 +743,9 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
     Cutting adds, for q in force_normal_N, force_rolling_N, force_side_N, torque_axis_Nm,
     force_magnitude_N: ``q_mean_steady`` (mean over rows with a*T <= time_s <= b*T, [a, b] the
     steady window, T = derived.cutter.duration) and ``q_peak`` (the value of largest magnitude
-    over the whole run, with its sign); ``contact_fraction_steady_1`` (steady rows with
+    over the whole run, with its sign); ``q_mean_cycles`` (oscillating cuts: mean over the
+    ``cycles_averaged_1`` whole cycles 2 pi / omega that fit in the steady window from its start, NaN when
+    none fits; other cuts: ``q_mean_steady``); ``contact_fraction_steady_1`` (steady rows with
     |F| > 1e-9 N), ``rolling_to_normal_ratio_1``, ``velocity_ratio_nu_1 = V / (e omega)``
     (NaN when e = 0) and the kinematics.
     """

@@ -568,13 +568,15 @@ def odc() -> list[CaseDef]:
                 outputs = {"series_every": 100, "bond_state_every": 5000}
                 if long:
                     outputs["steady_window"] = list(ODC_LONG_WINDOW)
-                what = (f"Table 5.1 sim {sim}." if sim < 100 else
-                        f"supplementary case {sim} (not in Table 5.1): a nu > 1 frequency series beside sims 12-14.")
                 if long:
                     what = (f"Table 5.1 sim {sim}, supplementary LONG cut: {travel} mm of travel, steady window "
                             f"{ODC_LONG_WINDOW[0]:g}-{ODC_LONG_WINDOW[1]:g} of it")
+                elif sim < 100:
+                    what = f"Table 5.1 sim {sim}."
+                else:
+                    what = f"supplementary case {sim} (not in Table 5.1): a nu > 1 frequency series beside sims 12-14."
                 cycles = travel * freq / (speed * 1e3)
-                window_cycles = ((ODC_LONG_WINDOW[1] - ODC_LONG_WINDOW[0]) if long else 0.5) * cycles
+                window_cycles = (ODC_LONG_WINDOW[1] - ODC_LONG_WINDOW[0]) * cycles  # quoted for the long cuts only
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): {what}",
                     f"Geometry factor 1 for the disc (cone 20/10 mm, rake 30, clearance {clr} deg), depth 4 mm and e = {e_mm} mm",

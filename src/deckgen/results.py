@@ -696,18 +696,15 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
     # oscillating cuts: means over the whole cycles that fit in the steady window from its start (a mean over
     # 1.4 cycles weights the phase that is in the window twice); no whole cycle: NaN; no oscillation: the
     # steady mean
-    n_cycles = 0
+    n_cycles, cyc = 0, mask
     if ecc > 0 and omega > 0:
         period = 2 * math.pi / omega
         n_cycles = int(math.floor((out["steady_end_s"] - out["steady_start_s"]) / period + 1e-9))
         t = ts["time_s"].to_numpy()
-        cyc = (t >= out["steady_start_s"]) & (t < out["steady_start_s"] + n_cycles * period)
+        cyc = (t >= out["steady_start_s"]) & (t < out["steady_start_s"] + n_cycles * period)  # empty at 0 cycles
     out["cycles_averaged_1"] = n_cycles
     for q in CUTTING_QUANTITIES:
-        if not (ecc > 0 and omega > 0):
-            out[f"{q}_mean_cycles"] = out[f"{q}_mean_steady"]
-        else:
-            out[f"{q}_mean_cycles"] = float(ts[q].to_numpy()[cyc].mean()) if n_cycles >= 1 and cyc.any() else _nan()
+        out[f"{q}_mean_cycles"] = float(ts[q].to_numpy()[cyc].mean()) if cyc.any() else _nan()
     out["contact_fraction_steady_1"] = (float((ts["force_magnitude_N"].to_numpy()[mask] > CONTACT_THRESHOLD_N).mean())
                                         if mask.any() else _nan())
     fn = out["force_normal_N_mean_steady"]

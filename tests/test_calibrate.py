@@ -255,6 +255,10 @@ def test_converges_on_stand_in(tmp_path, rock):
     assert all(abs(e) <= 0.05 for e in res.errors.values())
     rows = read_table(tmp_path / "t.csv")
     assert len(rows) == res.n_evals and [r["eval"] for r in rows] == list(range(res.n_evals))
+    for r in rows:  # the ratios the mechanism studies read; the stand-in reports no strain at the peak
+        assert r["ucs_to_bts_1"] == pytest.approx(r["ucs_Pa"] / r["bts_Pa"], rel=1e-12)
+        assert r["ucs_to_E_pct"] == pytest.approx(100 * r["ucs_Pa"] / r["E_Pa"], rel=1e-12)
+        assert math.isnan(r["ucs_strain_at_peak_1"])
     print(f"{rock}: {res.n_evals} evaluations, errors " + ", ".join(f"{k} {v:+.2%}" for k, v in res.errors.items()))
 
 
@@ -324,6 +328,20 @@ def test_resume_after_interrupt(tmp_path):
     idle = StandInEvaluator(noise=0.005, fail_rate=0.2, seed="r")
     res3 = calibrate(idle, card.targets, start, tmp_path / "part.csv", **kw)
     assert idle.calls == 0 and res3.best.key == full.best.key
+
+
+def test_table_written_before_the_ratio_columns_replays(tmp_path):
+    """Tables recorded before ucs_to_bts_1, ucs_to_E_pct and ucs_strain_at_peak_1 existed still resume."""
+    import pandas as pd
+
+    card = _card("sandstone")
+    start = analytic_start(card.targets)
+    first = calibrate(StandInEvaluator(noise=0.01), card.targets, start, tmp_path / "t.csv", max_evals=5)
+    old = pd.read_csv(tmp_path / "t.csv").drop(columns=["ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1"])
+    old.to_csv(tmp_path / "t.csv", index=False)
+    idle = StandInEvaluator(noise=0.01)
+    again = calibrate(idle, card.targets, start, tmp_path / "t.csv", max_evals=5)
+    assert idle.calls == 0 and [e.key for e in again.evaluations] == [e.key for e in first.evaluations]
 
 
 def test_table_of_other_targets_is_refused(tmp_path):
@@ -408,6 +426,7 @@ def test_tiny_dem_evaluation_and_cache_hit(tmp_path):
         assert math.isfinite(out[k]) and out[k] > 0, (k, out)
     assert out["engine_runs"] == 2 and ev.engine_runs == 2
     assert 0.1e6 < out["bts_Pa"] < out["ucs_Pa"] < 100e6 and 0.1e9 < out["E_Pa"] < 50e9
+    assert 0.1 * out["ucs_Pa"] / out["E_Pa"] < out["ucs_strain_at_peak_1"] < TINY_UCS["max_strain"]
     print(f"tiny DEM: UCS {out['ucs_Pa'] / 1e6:.3g} MPa, BTS {out['bts_Pa'] / 1e6:.3g} MPa, "
           f"E {out['E_Pa'] / 1e9:.3g} GPa in {wall:.1f} s")
     # same params again: answered from the folder, no engine run (an engine that cannot run proves it)

@@ -921,6 +921,8 @@ class DemEvaluator:
             mean = lambda runs, k: float(np.mean([_num(r.get(k)) for r in runs]))  # noqa: E731
             out = {"ucs_Pa": mean(ucs, "peak_stress_Pa"), "bts_Pa": mean(bts, "peak_stress_Pa"),
                    "E_Pa": mean(ucs, "youngs_modulus_Pa"), "ok": True, "error": ""}
+            # a peak far beyond the rock's UCS/E marks the ductile branch (docs/calibration.md, concrete run)
+            out["ucs_strain_at_peak_1"] = mean(ucs, "strain_at_peak_1")
             if len(bts) > 1:
                 out["bts_cv_1"] = float(np.std([_num(r.get("peak_stress_Pa")) for r in bts], ddof=1) / out["bts_Pa"])
             bad = [k for k in ("ucs_Pa", "bts_Pa", "E_Pa") if not (math.isfinite(out[k]) and out[k] > 0)]
@@ -934,6 +936,15 @@ class DemEvaluator:
         if not out["ok"]:
             failed.write_text(json.dumps({**out, "engine_runs": 0}, indent=2) + "\n")
         return out
+
+
+def _mechanism_text(p: "MicroParams") -> str:
+    """The clump size and bond factors of a point that differ from plain bonds, for the loop's log line."""
+    parts = [f"clumps {p.clump_size}"] if p.clump_size > 1 else []
+    plain = {"unbonded_fraction": 0.0, "bending_strength_factor": 1.0, "twisting_strength_factor": 1.0}
+    parts += [f"{f.replace('_strength_factor', '')} x{getattr(p, f):.4g}" if f != "unbonded_fraction" else
+              f"unbonded {getattr(p, f):.3g}" for f in OPTIONAL_BOND_FIELDS if getattr(p, f) != plain[f]]
+    return "".join(f", {t}" for t in parts)
 
 
 def _attempt_dir(folder: Path, name: str, attempt: int) -> Path:
@@ -1028,7 +1039,7 @@ TABLE_COLUMNS = [
     "eval", "key", "ok", "error", "youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa", "friction",
     "rolling_friction", "radius_multiplier", "gap_tolerance", "contact_modulus_ratio", "clump_size",
     *OPTIONAL_BOND_FIELDS, "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
-    "bts_error_1", "E_error_1",
+    "bts_error_1", "E_error_1", "ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1",
     "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]
 
@@ -1146,7 +1157,11 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                 "eval": ev.index, "key": key, "ok": ok, "error": err, **asdict(p),
                 "ucs_Pa": ev.ucs_Pa, "bts_Pa": ev.bts_Pa, "E_Pa": ev.E_Pa,
                 "ucs_error_1": e[0] if ok else float("nan"), "bts_error_1": e[1] if ok else float("nan"),
-                "E_error_1": e[2] if ok else float("nan"), "wall_s": wall, "engine_runs": ev.engine_runs,
+                "E_error_1": e[2] if ok else float("nan"),
+                "ucs_to_bts_1": ev.ucs_Pa / ev.bts_Pa if ok else float("nan"),
+                "ucs_to_E_pct": 100 * ev.ucs_Pa / ev.E_Pa if ok else float("nan"),
+                "ucs_strain_at_peak_1": _num(res.get("ucs_strain_at_peak_1")) if ok else float("nan"),
+                "wall_s": wall, "engine_runs": ev.engine_runs,
                 "target_ucs_Pa": t["ucs"], "target_bts_Pa": t["bts"], "target_E_Pa": t["E"],
                 "time_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             })
@@ -1158,7 +1173,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
             e = ev.rel_errors(t)
             log(f"eval {ev.index:3d}{' (replayed)' if ev.replayed else ''}: E_b {p.youngs_modulus_GPa:.4g} GPa, "
                 f"sigma_c {p.tensile_strength_MPa:.4g} MPa, tau_c {p.shear_strength_MPa:.4g} MPa, g {p.gap_tolerance:.3g}, "
-                f"E_c/E_b {p.contact_modulus_ratio:.3g} -> "
+                f"E_c/E_b {p.contact_modulus_ratio:.3g}{_mechanism_text(p)} -> "
                 f"UCS {ev.ucs_Pa / MPA:.4g} MPa ({e[0]:+.1%}), BTS {ev.bts_Pa / MPA:.4g} MPa ({e[1]:+.1%}), "
                 f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%})")
             if np.all(np.abs(e) <= tol):

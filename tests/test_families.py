@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 114 + 2 * len(NAMES)  # 114 case files + index.csv and README.md per family
+    assert len(files) == 120 + 2 * len(NAMES)  # 120 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -52,7 +52,7 @@ def test_case_counts_per_family():
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
-        ("odc", "full"): 10, ("odc", "reduced"): 16,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts
+        ("odc", "full"): 10, ("odc", "reduced"): 22,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts
     }
 
 
@@ -70,6 +70,9 @@ def test_every_family_case_validates_and_its_path_fits_the_block(family, scale):
         if scale == "reduced" and path.stem.endswith("_long"):  # the supplementary long ODC cuts: 3.7x the travel
             assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 600_000, (path, est)
             assert est["particle_steps_est"] <= 2e9, (path, est)  # <= ~17 min at 2 M particle-steps/s
+        elif scale == "reduced" and path.stem.endswith("_x1"):  # the ODC cuts at the seed's speed: 4x the steps
+            assert est["n_grains_est"] <= 2000 and est["steps_est"] <= 650_000, (path, est)
+            assert est["particle_steps_est"] <= 1.2e9, (path, est)  # <= ~10 min at 2 M particle-steps/s
         elif scale == "reduced":
             assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 400_000, (path, est)
             assert est["particle_steps_est"] <= 8e8, (path, est)  # <= ~7 min at 2 M particle-steps/s
@@ -142,6 +145,8 @@ def test_reduced_scale_headers_state_the_scaling():
         for path in _files(family, "reduced"):
             head = _header(path)
             for text in must:
+                if path.stem.endswith("_x1") and text == "Speed AND frequency x4":
+                    text = "Speed and frequency as the seed"
                 assert text in " ".join(head.replace("#", " ").split()), (path, text)
             assert ("placeholder" in head) != ("calibrated card" in head)
 
@@ -183,14 +188,16 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):
-        if c.name in sup:  # no full-scale twin: the stated seed-unit values x4
-            e, f, v = sup[c.name]
-            assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(4 * v), pytest.approx(4 * f))
+        k = 1 if c.name.endswith("_x1") else 4  # the x1 cuts keep the seed's speed and frequency
+        name = c.name.removesuffix("_x1")
+        if name in sup:  # no full-scale twin: the stated seed-unit values x4
+            e, f, v = sup[name]
+            assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(k * v), pytest.approx(k * f))
             assert c.kinematics.eccentricity_mm == pytest.approx(10 * e)
             continue
-        f = fulls[c.name.replace("_red_", "_").removesuffix("_long")]
-        assert c.kinematics.speed_m_s == pytest.approx(4 * f.kinematics.speed_m_s)
-        assert c.kinematics.frequency_hz == pytest.approx(4 * f.kinematics.frequency_hz)
+        f = fulls[name.replace("_red_", "_").removesuffix("_long")]
+        assert c.kinematics.speed_m_s == pytest.approx(k * f.kinematics.speed_m_s)
+        assert c.kinematics.frequency_hz == pytest.approx(k * f.kinematics.frequency_hz)
         assert c.kinematics.eccentricity_mm == f.kinematics.eccentricity_mm
         m = re.search(r"nu = V/\(e w\) = ([0-9.]+)", " ".join(_header(_files("odc", "reduced")[0]).split()))
         assert m is None or float(m.group(1)) > 0
@@ -374,7 +381,7 @@ def test_odc_trend_keeps_only_nu_below_one_and_half_a_cycle():
         ("d", 270, 0.30, 0.81, 26.0), ("e", 90, 1.77, 0.27, 130.0), ("f", 0, float("inf"), 0.0, 178.0)]
     tab = pd.DataFrame([{"case": c, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
                          "cycles_in_window_1": cy, "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": 0.4,
-                         "speed_full_m_s": 0.5} for c, f, nu, cy, F in rows])
+                         "speed_full_m_s": 0.5, "speedup_1": 4} for c, f, nu, cy, F in rows])
     t = fam.trend_table("odc", tab).set_index("trend")
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 4
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "runs"] == 3
@@ -382,6 +389,27 @@ def test_odc_trend_keeps_only_nu_below_one_and_half_a_cycle():
     assert t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "change_1"] < -0.4
     # runs at 45-67.5 rev/s (full-scale units) do not span the seed's 22.5-67.5: the change is extrapolated
     assert bool(t.loc["f_falls_with_freq_nu_lt_1_half_cycle", "extrapolated"])
+
+
+def test_odc_x1_cuts_feed_only_the_x1_trends():
+    """The cuts at the seed's speed (speedup_1 = 1) and the x4 cuts are fitted apart: same frequencies, other forces."""
+    import pandas as pd
+
+    rows = []
+    for k, forces in ((4, (60.0, 34.0, 26.0, 10.0, 7.0, 5.0)), (1, (30.0, 25.0, 20.0, 30.0, 31.0, 29.5))):
+        for (f_full, nu, ecc), F in zip([(45, 0.44, 0.4), (60, 0.33, 0.4), (67.5, 0.30, 0.4),
+                                         (45, 1.77, 0.1), (60, 1.33, 0.1), (67.5, 1.18, 0.1)], forces):
+            rows.append({"case": f"c{f_full}_{ecc}" + ("_x1" if k == 1 else ""), "frequency_hz": k * f_full,
+                         "frequency_full_hz": f_full, "velocity_ratio_nu_1": nu, "cycles_in_window_1": 0.6,
+                         "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": ecc, "speed_full_m_s": 0.5,
+                         "speedup_1": k})
+    t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")
+    for name in ("f_falls_with_freq_nu_lt_1_half_cycle", "f_flat_with_freq_nu_gt_1",
+                 "f_falls_with_freq_nu_lt_1_x1", "f_flat_with_freq_nu_gt_1_x1"):
+        assert t.loc[name, "runs"] == 3, name
+    assert t.loc["f_flat_with_freq_nu_gt_1", "change_1"] == pytest.approx(5.0 / 10.0 - 1, abs=0.05)
+    assert t.loc["f_flat_with_freq_nu_gt_1_x1", "change_1"] == pytest.approx(29.5 / 30.0 - 1, abs=0.05)
+    assert bool(t.loc["f_falls_with_freq_nu_lt_1_x1", "sign_as_seed"])
 
 
 def test_odc_nu_above_one_trend_expects_no_fall():
@@ -392,7 +420,7 @@ def test_odc_nu_above_one_trend_expects_no_fall():
         rows = [(180, 1.77, 0.54), (240, 1.33, 0.72), (270, 1.18, 0.81), (90, 3.54, 0.27)]
         return pd.DataFrame([{"case": f"x{i}", "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
                               "cycles_in_window_1": cy, "force_magnitude_N_mean_steady": F, "eccentricity_ratio_1": 0.1,
-                              "speed_full_m_s": 0.5} for i, ((f, nu, cy), F) in enumerate(zip(rows, forces))])
+                              "speed_full_m_s": 0.5, "speedup_1": 4} for i, ((f, nu, cy), F) in enumerate(zip(rows, forces))])
 
     flat = fam.trend_table("odc", table([15.0, 16.5, 14.8, 3.0])).set_index("trend").loc["f_flat_with_freq_nu_gt_1"]
     assert flat["runs"] == 3 and flat["expected_sign"] == 0  # the 0.27-cycle run is left out
@@ -445,7 +473,7 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
     n = sum(len(v) for v in fam.TREND_SUBSETS.values())
-    assert n == 20
+    assert n == 26
     for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
         assert f"{rule} {count}" in text, (rule, count, text[-1500:])
     for names in fam.TREND_SUBSETS.values():
@@ -472,7 +500,7 @@ def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_tren
     rows = []
     for name, f, nu, force in [("a_long", 90, 0.884, 2.0), ("b_long", 90, 1.768, 9.0), ("c_long", 90, 3.537, 12.0),
                                        ("d", 180, 0.44, 30.0), ("e", 240, 0.33, 20.0)]:
-        rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu,
+        rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu, "speedup_1": 4,
                      "eccentricity_ratio_1": 0.4, "speed_full_m_s": 0.5, "cycles_in_window_1": 1.0,
                      "force_magnitude_N_mean_steady": force, "force_magnitude_N_mean_cycles": force})
     t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")

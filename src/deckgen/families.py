@@ -521,6 +521,12 @@ ODC_SPEEDUP = 4.0  # reduced scale: forward speed and frequency x4 (nu = V/(e w)
 ODC_LONG_SIMS = (10, 11, 15, 16)
 ODC_LONG_TRAVEL_MM = 44
 ODC_LONG_WINDOW = (0.25, 0.95)
+#: Supplementary reduced cuts at the seed's speed and frequency (names ``odc_red_s<sim>_x1``): the 12 mm cuts of
+#: the two frequency series that hold at least half a cycle in the window (nu < 1: sims 12-14; nu > 1: 101-103),
+#: without the x4 speed-up. At x4 the disc, turning with the shaft, runs its rim at 4x the seed's speed, and the
+#: long cuts showed that a fast-turning disc carries a quarter of a sliding one's force (docs/families.md). Same
+#: path per mm of travel, 4x the steps.
+ODC_X1_SIMS = (12, 13, 14, 101, 102, 103)
 
 
 def odc() -> list[CaseDef]:
@@ -529,17 +535,19 @@ def odc() -> list[CaseDef]:
     out: list[CaseDef] = []
     for scale in SCALES:
         runs = [(row, False) for row in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ())]
+        runs = [(row, long, 1.0 if scale == "full" else ODC_SPEEDUP) for row, long in runs]
         if scale == "reduced":
-            runs += [(row, True) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
-        for (sim, ecc, rev_s, V, clr), long in runs:
+            runs += [(row, True, ODC_SPEEDUP) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
+            runs += [(row, False, 1.0) for row in SEED003_SIMS + ODC_SUPPLEMENTARY if row[0] in ODC_X1_SIMS]
+        for (sim, ecc, rev_s, V, clr), long, k in runs:
             if scale == "reduced" and sim == 19:
                 continue  # 4.5 rev/s at 0.1 m/s: < 0.3 cycles in a reduced block (docs/families.md)
             e_mm = _r(ecc * ODC_R_MM, 3)
             osc = ecc > 0
             nu = V / (e_mm * 1e-3 * 2 * math.pi * rev_s) if osc else math.inf
-            k = 1.0 if scale == "full" else ODC_SPEEDUP
             speed, freq = _r(V * k), _r(rev_s * k)
-            name = f"odc_{'full' if scale == 'full' else 'red'}_s{sim}" + ("_long" if long else "")
+            x1 = scale == "reduced" and k == 1.0
+            name = f"odc_{'full' if scale == 'full' else 'red'}_s{sim}" + ("_long" if long else "") + ("_x1" if x1 else "")
             kin: dict[str, Any] = {"mode": "oscillation" if osc else "linear", "speed_m_s": speed, "penetration_mm": 4}
             if osc:
                 kin.update(eccentricity_mm=e_mm, frequency_hz=freq, spin="shaft")
@@ -565,7 +573,8 @@ def odc() -> list[CaseDef]:
                 kin.update(travel_mm=travel, start_clearance_mm=0.3)
                 packing = {"radius_min_mm": 0.7, "radius_max_mm": 1.0}
                 bonds, contact, bond_lines = rock_micro(rock, soften_to_GPa=10)
-                outputs = {"series_every": 100, "bond_state_every": 5000}
+                # the same number of samples per mm of travel at either speed
+                outputs = {"series_every": int(400 / k), "bond_state_every": int(20000 / k)}
                 if long:
                     outputs["steady_window"] = list(ODC_LONG_WINDOW)
                 if long:
@@ -575,16 +584,22 @@ def odc() -> list[CaseDef]:
                     what = f"Table 5.1 sim {sim}."
                 else:
                     what = f"supplementary case {sim} (not in Table 5.1): a nu > 1 frequency series beside sims 12-14."
+                if x1:
+                    what += " Supplementary x1 cut: the seed's speed and frequency (no speed-up)."
                 cycles = travel * freq / (speed * 1e3)
                 window_cycles = (ODC_LONG_WINDOW[1] - ODC_LONG_WINDOW[0]) * cycles  # quoted for the long cuts only
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): {what}",
                     f"Geometry factor 1 for the disc (cone 20/10 mm, rake 30, clearance {clr} deg), depth 4 mm and e = {e_mm} mm",
                     f"(ratio {ecc}); grains r 0.7-1.0 mm (full: 0.65-0.95). Block trimmed to {L} x {W} x {H} mm (7 x 7 x 2 cm full), {travel} mm",
-                    f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
-                    + (f" = {nu:.2f} and" if osc else " and"),
-                    "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress",
-                    "rho*c*v 4x) and " + (f"{cycles:.2f} cycles fit in the travel ({window_cycles:.2f} in the steady window)."
+                    *([f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
+                       + (f" = {nu:.2f} and" if osc else " and"),
+                       "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress"]
+                      if not x1 else
+                      [f"of travel. Speed and frequency as the seed: {speed} m/s, {freq} Hz, nu = V/(e w) = {nu:.2f}; the disc rim",
+                       f"turns at {_r(2 * math.pi * rev_s * ODC_R_MM * 1e-3, 3)} m/s (x4 cuts: 4x that). Path, window and packing as odc_red_s{sim},"]),
+                    ("rho*c*v 4x) and " if not x1 else "4x its steps, and ")
+                    + (f"{cycles:.2f} cycles fit in the travel ({window_cycles:.2f} in the steady window)."
                                           if long and osc else
                                           "only " + (f"{cycles:.2f} cycles" if osc else "a linear cut") + " fit in the travel."),
                     *bond_lines,
@@ -600,7 +615,7 @@ def odc() -> list[CaseDef]:
                 "rock": rock, "seed_sim": sim, "eccentricity_ratio_1": ecc, "eccentricity_mm": e_mm,
                 "frequency_full_hz": rev_s, "frequency_hz": freq, "speed_full_m_s": V, "speed_m_s": speed,
                 "clearance_angle_deg": clr, "velocity_ratio_nu_1": _r(nu, 3) if osc else "inf",
-                "travel_mm": kin["travel_mm"]}))
+                "travel_mm": kin["travel_mm"], "speedup_1": _r(k)}))
     return out
 
 
@@ -633,7 +648,7 @@ def case_text(c: CaseDef) -> str:
 TREND_SUBSETS: dict[str, tuple[str, ...]] = {
     "linear_ccs": ("lin_red_s25_p6p4", "lin_red_s51_p6p4", "lin_red_s100_p6p4", "lin_red_s100_p1p9", "lin_red_s100_p7p6"),
     "odc": ("odc_red_s10", "odc_red_s12", "odc_red_s13", "odc_red_s14", "odc_red_s16", "odc_red_s101", "odc_red_s102",
-            "odc_red_s103"),
+            "odc_red_s103", *(f"odc_red_s{sim}_x1" for sim in ODC_X1_SIMS)),
     "rotary": ("rot_red_r250", "rot_red_r1000", "rot_red_r3000"),
     "indentation_asymmetric": ("ind_red_concrete_d150_t15", "ind_red_concrete_d150_t20", "ind_red_concrete_d150_t25",
                                "ind_red_concrete_d160_t20"),
@@ -830,19 +845,29 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1,
               "seed 003 Table 5.1, e/R 0.4, 0.5 m/s: 636 N at 22.5 rev/s -> 442.3 N at 67.5 rev/s (the thesis "
-              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and not case.str.endswith('_long')"),
+              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and not case.str.endswith('_long') and speedup_1 != 1"),
         Trend("f_falls_with_freq_nu_lt_1_half_cycle", "the same, only runs whose steady window holds at least half an "
               "oscillation cycle (a mean over a fraction of a cycle depends on the phase)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
-              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long')"),
+              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long') "
+                   "and speedup_1 != 1"),
         Trend("f_flat_with_freq_nu_gt_1", "no fall of the mean force with frequency when nu > 1 (no backward motion; "
               "supplementary runs 101-103, at least half a cycle in the window)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), 0, 0.0,
               "seed 003 sec. 5.4.3: the force 'only decreases when backwards movement exist[s]'; without it (e/R 0.1, 0.2 "
               "at 22.5 rev/s, nu 3.5, 1.8) the mean force is 735 and 754 N against 712 N without oscillation (taken as "
               "no change)", x_range=(45, 67.5),
-              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long')"),
+              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long') "
+                   "and speedup_1 != 1"),
+        Trend("f_falls_with_freq_nu_lt_1_x1", "the half-cycle trend above on the x1 cuts (the seed's speed and frequency)",
+              "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
+              442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
+              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1"),
+        Trend("f_flat_with_freq_nu_gt_1_x1", "no fall with frequency when nu > 1, on the x1 cuts (the seed's speed and "
+              "frequency)", "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"),
+              0, 0.0, "seed 003 sec. 5.4.3 (as above)", x_range=(45, 67.5),
+              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1"),
         Trend("f_rises_with_nu_long", "at one frequency, the mean force rises from nu < 1 (backward motion) to nu > 1 "
               "(long cuts; mean over the whole cycle in the window)", "force_magnitude_N_mean_cycles", "velocity_ratio_nu_1",
               (), +1,

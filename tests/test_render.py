@@ -209,3 +209,39 @@ def test_near_rock_shell_keeps_the_contact_band(tmp_path):
     assert xc_end - 0.5e-3 < end[low, 0] < xc_end + 1.5e-3  # just ahead of the centre: the front part is in the block
     # and none is further than the margin (plus the sphere radius) from the block at every time
     assert d["shell_margin_m"] == pytest.approx(1e-3)
+
+
+def test_shaft_sense_mirrors_the_eccentric_circle_and_the_spin(tmp_path):
+    """kinematics.shaft_sense: forward (default) slides the disc's lowest point forward at V + e w + w R at the bottom of
+    the circle; backward mirrors the circle (z = -e sin w t) and the spin, so that point moves at V - e w - w R."""
+    import numpy as np
+
+    from deckgen.deck import cutter_path, cutter_world_points
+    from deckgen.liggghts import render_liggghts_cut
+    from deckgen.spec import Case, SpecError, load_case
+
+    base = load_case(ROOT / "cases/odc/reduced/odc_red_s16.yaml")
+    R = base.cutter.diameter_mm * 1e-3 / 2
+    k = base.kinematics
+    V, e, w = k.speed_m_s, k.eccentricity_mm * 1e-3, 2 * math.pi * k.frequency_hz
+    h = 1e-9
+    for sense, z_sign, rim in (("forward", 1.0, V + e * w + w * R), ("backward", -1.0, V - e * w - w * R)):
+        case = base.model_copy(update={"kinematics": k.model_copy(update={"shaft_sense": sense})})
+        path = cutter_path(case, R)
+        t_bottom = (0.75 if sense == "forward" else 0.25) * 2 * math.pi / w  # the centre at the bottom of its circle
+        centre = cutter_world_points(np.zeros((1, 3)), path, t_bottom)[0]
+        assert centre[2] == pytest.approx(path["zc0"] - e, abs=1e-12)
+        assert cutter_world_points(np.zeros((1, 3)), path, 0.25 * 2 * math.pi / w)[0][2] == pytest.approx(
+            path["zc0"] + z_sign * e, abs=1e-12)
+        # the point of the disc that is lowest at that moment (offset rotated back by the spin angle)
+        th = path["spin_rate"] * t_bottom
+        rel = np.array([[R * math.sin(th), 0.0, -R * math.cos(th)]])
+        assert cutter_world_points(rel, path, t_bottom)[0][2] == pytest.approx(path["zc0"] - e - R, abs=1e-9)
+        vel = (cutter_world_points(rel, path, t_bottom + h) - cutter_world_points(rel, path, t_bottom - h)) / (2 * h)
+        assert vel[0][0] == pytest.approx(rim, rel=1e-5) and vel[0][2] == pytest.approx(0.0, abs=1e-4)
+        if sense == "backward":
+            with pytest.raises(SpecError, match="shaft_sense backward is rendered for LAMMPS only"):
+                render_liggghts_cut(case, tmp_path / "lig", bed="settle")
+    with pytest.raises(ValueError, match="only mode oscillation has a shaft"):
+        Case.model_validate({**base.model_dump(), "kinematics": {"mode": "linear", "speed_m_s": 2, "penetration_mm": 4,
+                                                                 "travel_mm": 12, "shaft_sense": "backward"}})

@@ -189,7 +189,7 @@ def cutter_world_points(rel: np.ndarray, path: dict[str, float], t: float) -> np
         return np.column_stack([path["axis_x"] + qx, path["axis_y"] + qy, path["zc0"] + Z1])
     V, e, w, ind = path["V"], path["ecc"], path["omega"], path["mode_indent"]
     xc = path["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0))
-    zc = path["zc0"] - ind * V * t + (1 - ind) * e * math.sin(w * t)
+    zc = path["zc0"] - ind * V * t + (1 - ind) * path.get("sense", 1.0) * e * math.sin(w * t)
     return np.column_stack([xc + X1, path["yc0"] + Y, zc + Z1])
 
 
@@ -292,10 +292,13 @@ def cutter_path(case: Case, R: float) -> dict[str, float]:
             raise SpecError(
                 f"kinematics.travel_mm: the cutter would leave the block (needs length >= "
                 f"{(travel + 2 * half_chord + clear) / MM:.1f} mm; fix: shorter travel or longer block)")
-    spin_rate = {"none": 0.0, "rolling": V / R, "shaft": -w}[k.spin]
+    sense = 1.0 if k.shaft_sense == "forward" else -1.0  # the eccentric circle's sense (z = sense e sin(w t))
+    spin_rate = {"none": 0.0, "rolling": V / R, "shaft": -sense * w}[k.spin]
     out = dict(xc0=xc0, yc0=yc0, zc0=zc0, V=V, ecc=e, omega=w, spin_rate=spin_rate, duration=duration,
                travel=travel, penetration=p, radius=R, mode_indent=1.0 if k.mode == "indentation" else 0.0,
                yaw_rate=0.0, rotary_radius=0.0, axis_x=0.0, axis_y=0.0)
+    if sense < 0:  # only the mirrored circle carries the key (spec.json of forward cuts unchanged)
+        out["sense"] = sense
     if k.mode == "rotary":
         r = k.rotary_radius_mm * MM
         phi_end = travel / r
@@ -577,6 +580,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         if grooves.any():
             derived["neighbour_groove_grains_removed"] = int(grooves.sum())
         ctx["rotary"] = case.kinematics.mode == "rotary"
+        ctx["shaft_backward"] = path.get("sense", 1.0) < 0  # the mirrored eccentric circle (kinematics.shaft_sense)
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),
                         dict(i=2, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut")]

@@ -294,6 +294,11 @@ class Kinematics(_Model):
     spin: Literal["none", "rolling", "shaft"] = _f(
         "none", "token", "Spin of the disc about its own axis: none, rolling (v/R) or shaft (with the eccentric shaft)."
     )
+    shaft_sense: Literal["forward", "backward"] = Field(
+        "forward", exclude_if=lambda v: v == "forward", json_schema_extra={"unit": "token"}, description="oscillation: sense of the eccentric shaft's turn. forward: the centre circles so that it moves "
+        "fastest forward at the bottom (z = e sin(w t)), and a disc turning with the shaft (spin shaft) moves its lowest "
+        "point forward relative to its centre; backward: the mirror turn (z = -e sin(w t)), the lowest point moves "
+        "backward as on a rolling disc. Seed 003 does not state the sense. The default is left out of resolved cases.")
     neighbour_spacing_mm: float | None = _f(
         None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "
         "cut (relieved cutting between neighbours, seed 001); none = an isolated (unrelieved) groove.", gt=0,
@@ -381,6 +386,8 @@ class Case(_Model):
                 )
             if k.mode == "indentation" and k.edge_distance_mm >= sp.width_mm:
                 raise ValueError("kinematics.edge_distance_mm must be less than specimen.width_mm (it is measured from the y min face)")
+            if k.shaft_sense != "forward" and k.mode != "oscillation":
+                raise ValueError("kinematics.shaft_sense: only mode oscillation has a shaft (remove shaft_sense)")
             if k.spin == "shaft" and k.mode != "oscillation":
                 raise ValueError("kinematics.spin: shaft needs mode oscillation (use none or rolling)")
             if self.cutter.kind == "cone_disc" and self.cutter.small_diameter_mm >= self.cutter.diameter_mm:

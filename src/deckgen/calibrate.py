@@ -941,9 +941,8 @@ class DemEvaluator:
 def _mechanism_text(p: "MicroParams") -> str:
     """The clump size and bond factors of a point that differ from plain bonds, for the loop's log line."""
     parts = [f"clumps {p.clump_size}"] if p.clump_size > 1 else []
-    plain = {"unbonded_fraction": 0.0, "bending_strength_factor": 1.0, "twisting_strength_factor": 1.0}
     parts += [f"{f.replace('_strength_factor', '')} x{getattr(p, f):.4g}" if f != "unbonded_fraction" else
-              f"unbonded {getattr(p, f):.3g}" for f in OPTIONAL_BOND_FIELDS if getattr(p, f) != plain[f]]
+              f"unbonded {getattr(p, f):.3g}" for f, plain in p.optional_defaults().items() if getattr(p, f) != plain]
     return "".join(f", {t}" for t in parts)
 
 

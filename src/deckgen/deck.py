@@ -580,7 +580,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         if grooves.any():
             derived["neighbour_groove_grains_removed"] = int(grooves.sum())
         ctx["rotary"] = case.kinematics.mode == "rotary"
-        ctx["shaft_backward"] = path.get("sense", 1.0) < 0  # the mirrored eccentric circle (kinematics.shaft_sense)
+        ctx["shaft_backward"] = case.kinematics.shaft_sense == "backward"  # the mirrored eccentric circle
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),
                         dict(i=2, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut")]

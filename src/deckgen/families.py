@@ -588,20 +588,24 @@ def odc() -> list[CaseDef]:
                     what += " Supplementary x1 cut: the seed's speed and frequency (no speed-up)."
                 cycles = travel * freq / (speed * 1e3)
                 window_cycles = (ODC_LONG_WINDOW[1] - ODC_LONG_WINDOW[0]) * cycles  # quoted for the long cuts only
+                fit = (f"{cycles:.2f} cycles fit in the travel ({window_cycles:.2f} in the steady window)." if long and osc
+                       else "only " + (f"{cycles:.2f} cycles" if osc else "a linear cut") + " fit in the travel.")
+                if x1:
+                    speed_lines = [
+                        f"of travel. Speed and frequency as the seed: {speed} m/s, {freq} Hz, nu = V/(e w) = {nu:.2f}; the disc rim",
+                        f"turns at {_r(2 * math.pi * rev_s * ODC_R_MM * 1e-3, 3)} m/s (x4 cuts: 4x that). Path, window and packing as odc_red_s{sim},",
+                        "4x its steps, and " + fit]
+                else:
+                    speed_lines = [
+                        f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
+                        + (f" = {nu:.2f} and" if osc else " and"),
+                        "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress",
+                        "rho*c*v 4x) and " + fit]
                 header = [
                     f"Seed 003 (Grashof thesis), oscillating disc cutter, REDUCED SCALE (2 cores): {what}",
                     f"Geometry factor 1 for the disc (cone 20/10 mm, rake 30, clearance {clr} deg), depth 4 mm and e = {e_mm} mm",
                     f"(ratio {ecc}); grains r 0.7-1.0 mm (full: 0.65-0.95). Block trimmed to {L} x {W} x {H} mm (7 x 7 x 2 cm full), {travel} mm",
-                    *([f"of travel. Speed AND frequency x4: {speed} m/s, {freq} Hz (seed {V} m/s, {rev_s} rev/s), so nu = V/(e w)"
-                       + (f" = {nu:.2f} and" if osc else " and"),
-                       "the path shape per mm of travel are the seed's, but tangential speeds e*w are 4x (impact stress"]
-                      if not x1 else
-                      [f"of travel. Speed and frequency as the seed: {speed} m/s, {freq} Hz, nu = V/(e w) = {nu:.2f}; the disc rim",
-                       f"turns at {_r(2 * math.pi * rev_s * ODC_R_MM * 1e-3, 3)} m/s (x4 cuts: 4x that). Path, window and packing as odc_red_s{sim},"]),
-                    ("rho*c*v 4x) and " if not x1 else "4x its steps, and ")
-                    + (f"{cycles:.2f} cycles fit in the travel ({window_cycles:.2f} in the steady window)."
-                                          if long and osc else
-                                          "only " + (f"{cycles:.2f} cycles" if osc else "a linear cut") + " fit in the travel."),
+                    *speed_lines,
                     *bond_lines,
                 ]
             contact = {**contact, "cutter_friction": 0.3}

@@ -406,7 +406,7 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     files = build_cutter_files(case, out)
     R = files["summary"]["diameter_m"] / 2.0
     path = cutter_path(case, R)
-    if path.get("sense", 1.0) < 0:  # the stacked move/mesh of this deck orbit in one sense only
+    if case.kinematics.shaft_sense == "backward":  # the stacked move/mesh of this deck orbit in one sense only
         raise SpecError(f"case {case.name}: kinematics.shaft_sense backward is rendered for LAMMPS only "
                         f"(fix: engine lammps, or shaft_sense forward)")
     half_width = 0.5 * files["summary"]["width_m"]

@@ -115,11 +115,12 @@ def test_bending_factor_reaches_the_deck(tmp_path):
     assert c1["F_rc"] == c0["F_rc"] and c1["k_b"] == c0["k_b"]
 
 
-def test_liggghts_bonded_deck_refuses_what_it_cannot_express(tmp_path):
+@pytest.mark.parametrize("field, value", [("unbonded_fraction", 0.2), ("strength_weibull_modulus", 3.0)])
+def test_liggghts_bonded_deck_refuses_what_it_cannot_express(tmp_path, field, value):
     from deckgen.liggghts import render_liggghts_ucs_bonded
 
-    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"unbonded_fraction": 0.2}})
-    with pytest.raises(SpecError, match=r"cannot express bonds\.unbonded_fraction \(fix: use engine lammps"):
+    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {field: value}})
+    with pytest.raises(SpecError, match=rf"cannot express bonds\.{field} \(fix: use engine lammps"):
         render_liggghts_ucs_bonded(case, tmp_path / "lig")
 
 

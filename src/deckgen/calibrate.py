@@ -303,7 +303,8 @@ def write_card(card: MaterialCard, path: str | Path, header: str = "") -> Path:
 # =============================================================================== parameters
 #: MicroParams fields (same names as bonds.*) added after points were recorded: they enter keys and case
 #: overrides only away from their defaults, so earlier points keep their keys
-OPTIONAL_BOND_FIELDS = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor")
+OPTIONAL_BOND_FIELDS = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor",
+                        "strength_weibull_modulus", "shrink_before_bonding")
 
 
 @dataclass(frozen=True)
@@ -324,6 +325,8 @@ class MicroParams:
     unbonded_fraction: float = 0.0  # bondable pairs left without a bond (bonds.unbonded_fraction)
     bending_strength_factor: float = 1.0  # critical bending torque / parallel-bond value (bonds.*)
     twisting_strength_factor: float = 1.0  # critical twisting torque / parallel-bond value (bonds.*)
+    strength_weibull_modulus: float = 0.0  # bond strength scatter (bonds.strength_weibull_modulus; 0 = none)
+    shrink_before_bonding: float = 0.02  # radius shrink before bonding (bonds.*): the initial gap of every contact
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -941,8 +944,10 @@ class DemEvaluator:
 def _mechanism_text(p: "MicroParams") -> str:
     """The clump size and bond factors of a point that differ from plain bonds, for the loop's log line."""
     parts = [f"clumps {p.clump_size}"] if p.clump_size > 1 else []
-    parts += [f"{f.replace('_strength_factor', '')} x{getattr(p, f):.4g}" if f != "unbonded_fraction" else
-              f"unbonded {getattr(p, f):.3g}" for f, plain in p.optional_defaults().items() if getattr(p, f) != plain]
+    label = {"unbonded_fraction": "unbonded {:.3g}", "strength_weibull_modulus": "Weibull m {:.3g}",
+             "shrink_before_bonding": "shrink {:.3g}"}
+    parts += [label.get(f, f"{f.replace('_strength_factor', '')} x{{:.4g}}").format(getattr(p, f))
+              for f, plain in p.optional_defaults().items() if getattr(p, f) != plain]
     return "".join(f", {t}" for t in parts)
 
 

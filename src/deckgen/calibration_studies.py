@@ -127,6 +127,20 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
                                                            "tensile_strength_MPa": 120.0, "shear_strength_MPa": 120.0}),
     # E from the contacts instead of the bonds (E_c/E_b 4 -> 10) at the failing twisting x2 point: lower UCS/E?
     ("c16t2 + E_c/E_b 10", {"twisting_strength_factor": 2.0, "clump_size": 16, "contact_modulus_ratio": 10.0}),
+    # weakest-link flaws: Weibull-distributed bond strengths (mean 1; CoV 0.23 / 0.36 / 0.52): does tension, which
+    # runs one crack through the weakest bonds, lose more than compression, which needs many bonds to break?
+    ("Weibull m 5", {"strength_weibull_modulus": 5.0}),
+    ("Weibull m 3", {"strength_weibull_modulus": 3.0}),
+    ("Weibull m 2", {"strength_weibull_modulus": 2.0}),
+    ("c16t2 + Weibull m 3", {"twisting_strength_factor": 2.0, "clump_size": 16, "strength_weibull_modulus": 3.0}),
+    # the 2 % radius shrink before bonding opens a gap of 2 % of the radii at every contact: an unbonded pair then
+    # carries no compression until the specimen has strained that far. Without it, unbonded pairs are closed
+    # contacts from the start (the cohesionless cracks of Schoepfer et al. 2009, or the slit elements of a
+    # flat-joint model): they carry compression at once and no tension
+    ("shrink 0.005", {"shrink_before_bonding": 0.005}),
+    ("no shrink", {"shrink_before_bonding": 0.0}),
+    ("no shrink, unbonded 0.25", {"unbonded_fraction": 0.25, "shrink_before_bonding": 0.0}),
+    ("no shrink, unbonded 0.5", {"unbonded_fraction": 0.5, "shrink_before_bonding": 0.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

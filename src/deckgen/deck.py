@@ -27,6 +27,8 @@ from deckgen.bonds import (
     make_bond_table,
     stable_timestep,
     unbonded_mask,
+    weibull_cov,
+    weibull_strength_factors,
 )
 from deckgen.datafile import write_bpm_data
 from deckgen.packing import ensure_packing, load_packing, specimen_region
@@ -367,13 +369,19 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         pairs = pairs[~drop]
         if intra is not None:
             intra = intra[~drop]
+    strength = None
+    if b.strength_weibull_modulus > 0 and b.enabled:  # weakest-link flaws: per-bond strength factors, mean 1
+        strength = weibull_strength_factors(len(pairs), b.strength_weibull_modulus, seed=case.packing.seed)
+        if intra is not None:
+            strength[intra] = 1.0
     table = make_bond_table(
         atoms.x, r, mass, pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
         sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
         radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
         bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
         intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor,
-        bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor)
+        bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
+        strength_factor=strength, bins_strength=b.type_bins_strength)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
@@ -434,6 +442,17 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     if n_unbonded:
         derived["unbonded"] = {"fraction": b.unbonded_fraction, "unbonded_pairs": n_unbonded,
                                "bondable_pairs": n_unbonded + int(len(pairs))}
+    if strength is not None:
+        plain = np.ones(len(pairs), bool) if intra is None else ~intra
+        t0 = table.types[plain] - 1  # the factor each bond gets in the deck: its type's mean
+        binned = (np.bincount(t0, weights=strength[plain], minlength=table.ntypes)
+                  / np.maximum(np.bincount(t0, minlength=table.ntypes), 1))[t0]
+        derived["strength_heterogeneity"] = {
+            "weibull_modulus": b.strength_weibull_modulus, "cov_distribution": weibull_cov(b.strength_weibull_modulus),
+            "cov_drawn": float(strength[plain].std() / strength[plain].mean()),
+            "cov_binned": float(binned.std() / binned.mean()),
+            "factor_min": float(strength[plain].min()), "factor_max": float(strength[plain].max()),
+            "bins_strength": b.type_bins_strength}
     if clumps is not None and intra is not None:
         dist = clump_sizes(clumps)
         multi = {k: v for k, v in dist.items() if k > 1}

@@ -118,7 +118,9 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
                                                              "tensile_strength_MPa": 30.0, "shear_strength_MPa": 30.0}),
     # twisting x10 and x100 with clumps of 16 did not fail in compression within 4 % strain: the twisting
     # factor between 1 (clumps of 16: fails at 1.0 %) and 10
+    ("c16 + twisting x1.5", {"twisting_strength_factor": 1.5, "clump_size": 16}),
     ("c16 + twisting x2", {"twisting_strength_factor": 2.0, "clump_size": 16}),
+    ("c16 + twisting x2.5", {"twisting_strength_factor": 2.5, "clump_size": 16}),
     ("c16 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 16}),
     ("c16 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 16}),
     # at twisting x2 (the strongest that fails): tau/sigma 2 (sigma_c 30 at tau_c 60), and both strengths doubled
@@ -141,6 +143,12 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("no shrink", {"shrink_before_bonding": 0.0}),
     ("no shrink, unbonded 0.25", {"unbonded_fraction": 0.25, "shrink_before_bonding": 0.0}),
     ("no shrink, unbonded 0.5", {"unbonded_fraction": 0.5, "shrink_before_bonding": 0.0}),
+    # a cylinder of 776 grains holds only about 48 clumps of 16: does the twisting factor act as smoothly on
+    # smaller clumps (about 97 of 8, 194 of 4 per cylinder)?
+    ("c8 + twisting x2", {"twisting_strength_factor": 2.0, "clump_size": 8}),
+    ("c8 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 8}),
+    ("c4 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 4}),
+    ("c4 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 4}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

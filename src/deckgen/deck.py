@@ -182,6 +182,16 @@ def cutter_world_points(rel: np.ndarray, path: dict[str, float], t: float) -> np
     """
     X, Y, Z = rel[:, 0], rel[:, 1], rel[:, 2]
     th = path["spin_rate"] * t
+    alpha = path.get("axis_tilt", 0.0)
+    if alpha:  # tilted disc: spin about its own axis (0, cos a, sin a), orbit in its plane (cutter_path)
+        ca, sa = math.cos(alpha), math.sin(alpha)
+        Yu, Zu = ca * Y + sa * Z, -sa * Y + ca * Z  # into the disc frame (axis along y)
+        X1 = X * math.cos(th) + Zu * math.sin(th)
+        Z1u = -X * math.sin(th) + Zu * math.cos(th)
+        V, e, w = path["V"], path["ecc"], path["omega"]
+        oz = path.get("sense", 1.0) * e * math.sin(w * t)  # the orbit's offset along the disc frame's z
+        xc = path["xc0"] + V * t + e * (math.cos(w * t) - 1.0)
+        return np.column_stack([xc + X1, path["yc0"] + ca * Yu - sa * (Z1u + oz), path["zc0"] + sa * Yu + ca * (Z1u + oz)])
     X1 = X * math.cos(th) + Z * math.sin(th)
     Z1 = -X * math.sin(th) + Z * math.cos(th)
     if path["rotary_radius"]:
@@ -268,8 +278,15 @@ def fixed_face_boxes(sp: CuttingBlock, reg: Any, slab: float, pad: float) -> lis
     return faces
 
 
-def cutter_path(case: Case, R: float) -> dict[str, float]:
-    """Initial centre, duration and motion parameters of the cutter (SI)."""
+def cutter_path(case: Case, R: float, axis: np.ndarray | None = None) -> dict[str, float]:
+    """Initial centre, duration and motion parameters of the cutter (SI).
+
+    ``axis``: the disc axis of the built cutter (``mesh.metadata["deckgen_axis"]``). When it is tilted about x
+    (a cone's clearance angle, ``cutter.tilt_deg``) and the disc spins or orbits, the path carries ``axis_tilt``
+    (the angle α of the axis (0, cos α, sin α) from y): the disc then spins about its own axis and its centre
+    orbits in the disc's plane, as a disc on bearings on an eccentric shaft parallel to it (a real ODC, the
+    whole tool tilted by the clearance angle). Untilted paths do not carry the key.
+    """
     sp = case.specimen
     k = case.kinematics
     assert isinstance(sp, CuttingBlock)
@@ -301,6 +318,17 @@ def cutter_path(case: Case, R: float) -> dict[str, float]:
                yaw_rate=0.0, rotary_radius=0.0, axis_x=0.0, axis_y=0.0)
     if sense < 0:  # only the mirrored circle carries the key (spec.json of forward cuts unchanged)
         out["sense"] = sense
+    if axis is not None:
+        a = np.asarray(axis, dtype=float)
+        alpha = math.atan2(float(a[2]), float(a[1]))
+        if abs(float(a[0])) > 1e-9:
+            raise SpecError(f"cutter: the disc axis {a.tolist()} leaves the y-z plane; only tilts about the cut "
+                            "direction x are supported (fix: cutter.tilt_deg / clearance_angle_deg only)")
+        if abs(alpha) > 1e-12 and (spin_rate != 0.0 or e > 0.0):
+            if k.mode in ("rotary", "indentation"):
+                raise SpecError(f"case {case.name}: a tilted disc (cutter.tilt_deg or a cone's clearance angle) that "
+                                f"spins in {k.mode} is not rendered (fix: tilt 0, or kinematics.spin none)")
+            out["axis_tilt"] = alpha
     if k.mode == "rotary":
         r = k.rotary_radius_mm * MM
         phi_end = travel / r
@@ -539,7 +567,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         title = f"{case.kinematics.mode} cutting of a bonded block by a {case.cutter.kind}"
         files = build_cutter_files(case, out)
         R = files["summary"]["diameter_m"] / 2.0
-        path = cutter_path(case, R)
+        path = cutter_path(case, R, axis=files["mesh"].metadata.get("deckgen_axis"))
         rs = case.cutter.shell_radius_mm * MM
         if rs > 0.5 * float(r.min()):
             raise SpecError(f"cutter.shell_radius_mm: {case.cutter.shell_radius_mm:g} mm is more than half the smallest "
@@ -583,7 +611,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("mu_cut", c.cutter_friction, "cutter-grain friction", "1"),
             _var("mu_roll_cut", 0.0, "cutter-grain rolling friction", "1"),
             *path_variables(path),
-            _var("spin_rate", path["spin_rate"], "spin about the disc axis (y)", "rad/s"),
+            _var("spin_rate", path["spin_rate"], "spin about the disc's own (tilted) axis" if "axis_tilt" in path
+                 else "spin about the disc axis (y)", "rad/s"),
+            *([_var("ca", math.cos(path["axis_tilt"]), "cos of the disc axis tilt about x", "1"),
+               _var("sa", math.sin(path["axis_tilt"]), "sin of the disc axis tilt about x", "1")]
+              if "axis_tilt" in path else []),
             _var("indent", path["mode_indent"], "1 = push along -z (indentation), 0 = cut along +x", "1"),
             *([_var("r_rot", path["rotary_radius"], "rotary path radius", "m"),
                _var("yaw_rate", path["yaw_rate"], "yaw rate of the disc on its circular path (v/r)", "rad/s"),
@@ -600,6 +632,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             derived["neighbour_groove_grains_removed"] = int(grooves.sum())
         ctx["rotary"] = case.kinematics.mode == "rotary"
         ctx["shaft_backward"] = case.kinematics.shaft_sense == "backward"  # the mirrored eccentric circle
+        ctx["tilted"] = "axis_tilt" in path  # tilted disc: spin about its own axis, orbit in its plane
         ctx["integrate_group"] = "mobile"
         pair_coeffs += [dict(i=1, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut"),
                         dict(i=2, j=2, E="E_cut", mu="mu_cut", mu_roll="mu_roll_cut")]

@@ -405,10 +405,13 @@ def render_liggghts_cut(case: Case, out: str | Path, *, cohesion_energy_density:
     # ---- cutter and path (shared with the LAMMPS decks)
     files = build_cutter_files(case, out)
     R = files["summary"]["diameter_m"] / 2.0
-    path = cutter_path(case, R)
+    path = cutter_path(case, R, axis=files["mesh"].metadata.get("deckgen_axis"))
     if case.kinematics.shaft_sense == "backward":  # the stacked move/mesh of this deck orbit in one sense only
         raise SpecError(f"case {case.name}: kinematics.shaft_sense backward is rendered for LAMMPS only "
                         f"(fix: engine lammps, or shaft_sense forward)")
+    if "axis_tilt" in path:  # the stacked move/mesh below turn about y only
+        raise SpecError(f"case {case.name}: a tilted disc (cutter.tilt_deg or a cone's clearance angle) that spins or "
+                        "orbits about its own axis is rendered for LAMMPS only (fix: engine lammps, or tilt 0)")
     half_width = 0.5 * files["summary"]["width_m"]
 
     # ---- grains: radius classes at the bin centres of [rmin, rmax], equal number fractions

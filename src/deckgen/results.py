@@ -15,7 +15,7 @@
     torque ON the cutter FROM the rock, torque about the moving disc centre) plus the cutter frame
     (disc axis y, cut direction +x, z up): ``force_normal_N = Fz`` (rock pushes the disc up),
     ``force_rolling_N = -Fx`` (positive when it resists the forward motion), ``force_side_N = Fy``,
-    ``torque_axis_Nm = Ty``; ``cutter_advance_m = x - x0``; indentation also
+    ``torque_axis_Nm = Ty`` (a tilted disc that spins: T along its own axis); ``cutter_advance_m = x - x0``; indentation also
     ``penetration_m = (z0 - z) - start_clearance``.
 ``broken``
     one row per broken bond: ``id1, id2`` (id1 < id2), ``step`` (time step of breakage),
@@ -364,6 +364,9 @@ def _cutting_timeseries(raw: pd.DataFrame, path: Path, n0: int, spec: dict[str, 
     ts["force_side_N"] = -fx * s_ + fy * c
     ts["torque_axis_Nm"] = -ts["torque_x_Nm"] * s_ + ts["torque_y_Nm"] * c
     cut = spec["derived"].get("cutter", {})
+    alpha = float(cut.get("axis_tilt", 0.0) or 0.0)
+    if alpha:  # a tilted disc spins about its own axis (0, cos a, sin a) (deckgen.deck.cutter_path; never rotary)
+        ts["torque_axis_Nm"] = ts["torque_y_Nm"] * math.cos(alpha) + ts["torque_z_Nm"] * math.sin(alpha)
     if float(cut.get("rotary_radius", 0.0) or 0.0) > 0:
         ts["cutter_advance_m"] = float(cut["rotary_radius"]) * phi  # arc length along the path
     else:
@@ -637,9 +640,10 @@ def grains_inside_cutter(xyz: np.ndarray, spec: dict[str, Any], t: float) -> int
     A grain touching the shell from outside keeps its centre at least its radius outside the true
     surface (the shell spheres sit their own radius inside it), so a centre inside the body means the
     grain got through a gap of the shell or through a part ``shell_coverage: near_rock`` left out.
-    The body is the revolved profile about the disc axis, moved as the deck moves it: the axis
-    (tilted by a clearance angle or ``tilt_deg``) spins about y with the disc and yaws on a rotary
-    path. None when the geometry cannot be rebuilt from the spec.
+    The body is the revolved profile about the disc axis, moved as the deck moves it
+    (:func:`deckgen.deck.cutter_world_points`): a tilted axis (clearance angle or ``tilt_deg``) stays fixed
+    while the disc spins about it (spec.json files from before ``axis_tilt``: spun about y), and the axis
+    yaws on a rotary path. None when the geometry cannot be rebuilt from the spec.
     """
     from types import SimpleNamespace
 

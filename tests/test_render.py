@@ -245,3 +245,28 @@ def test_shaft_sense_mirrors_the_eccentric_circle_and_the_spin(tmp_path):
     with pytest.raises(ValueError, match="only mode oscillation has a shaft"):
         Case.model_validate({**base.model_dump(), "kinematics": {"mode": "linear", "speed_m_s": 2, "penetration_mm": 4,
                                                                  "travel_mm": 12, "shaft_sense": "backward"}})
+
+
+def test_tilted_disc_path_carries_its_axis_tilt_and_refuses_what_is_not_rendered():
+    """cutter_path: a tilted disc that spins or orbits carries axis_tilt (the axis angle from y about x); an untilted
+    one, or a tilted disc that neither spins nor orbits, does not (their decks and spec.json stay as before); a tilted
+    disc spinning on a rotary path is refused in one line."""
+    import numpy as np
+
+    from deckgen.deck import cutter_path
+    from deckgen.spec import SpecError, load_case
+
+    case = load_case(ROOT / "cases/odc/reduced/odc_red_s16.yaml")  # cone, clearance 9 deg, spin shaft, e 1 mm
+    R = 0.01
+    c9 = math.radians(9.0)
+    p = cutter_path(case, R, axis=np.array([0.0, math.cos(c9), -math.sin(c9)]))
+    assert p["axis_tilt"] == pytest.approx(-c9, abs=1e-15)
+    assert "axis_tilt" not in cutter_path(case, R, axis=np.array([0.0, 1.0, 0.0]))
+    assert "axis_tilt" not in cutter_path(case, R)
+    straight = load_case(ROOT / "cases/odc/reduced/odc_red_s10.yaml")  # no oscillation, no spin
+    assert "axis_tilt" not in cutter_path(straight, R, axis=np.array([0.0, math.cos(c9), -math.sin(c9)]))
+    rot = load_case(ROOT / "tests/data/cases/tiny_rotary.yaml")
+    with pytest.raises(SpecError, match="tilted disc .* spins in rotary is not rendered"):
+        cutter_path(rot, 0.006, axis=np.array([0.0, math.cos(0.1), math.sin(0.1)]))
+    with pytest.raises(SpecError, match="leaves the y-z plane"):
+        cutter_path(case, R, axis=np.array([0.1, 0.99, 0.0]))

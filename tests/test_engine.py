@@ -234,7 +234,6 @@ def test_tilted_disc_spins_about_its_own_axis(tmp_path, cache):
     in the plane normal to a, and each sphere's velocity is v_c + spin_rate a x (p - c). Then the Python copy
     (used by the leak check and the near-rock trimming) agrees to the dump's precision."""
     from deckgen.deck import cutter_world_points
-    from deckgen.parse.dump import iter_frames
 
     case = load_case(CASES / "tiny_cut.yaml", overrides={"cutter": {"tilt_deg": 8.0}})
     out = tmp_path / "tilt"

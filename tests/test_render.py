@@ -270,3 +270,28 @@ def test_tilted_disc_path_carries_its_axis_tilt_and_refuses_what_is_not_rendered
         cutter_path(rot, 0.006, axis=np.array([0.0, math.cos(0.1), math.sin(0.1)]))
     with pytest.raises(SpecError, match="leaves the y-z plane"):
         cutter_path(case, R, axis=np.array([0.1, 0.99, 0.0]))
+
+
+def test_penetration_at_orbit_bottom_lifts_the_orbit_by_e():
+    """kinematics.penetration_at: orbit_bottom raises the centre path by e cos(tilt), so the deepest point of the
+    orbit (not the start) is p deep; the default (start) leaves the path as before and out of resolved cases."""
+    import numpy as np
+
+    from deckgen.deck import cutter_path, cutter_world_points
+    from deckgen.spec import Case, load_case
+
+    base = load_case(ROOT / "cases/odc/reduced/odc_red_s11.yaml")  # e 4 mm, clearance 9 deg
+    k = base.kinematics
+    assert "penetration_at" not in base.model_dump(mode="json")["kinematics"]
+    low = base.model_copy(update={"kinematics": k.model_copy(update={"penetration_at": "orbit_bottom"})})
+    c9 = math.radians(9.0)
+    ax = np.array([0.0, math.cos(c9), -math.sin(c9)])
+    p0, p1 = cutter_path(base, 0.01, axis=ax), cutter_path(low, 0.01, axis=ax)
+    e = k.eccentricity_mm * 1e-3
+    assert p1["zc0"] - p0["zc0"] == pytest.approx(e * math.cos(c9), rel=1e-12)
+    w = p1["omega"]
+    z_bottom = min(cutter_world_points(np.zeros((1, 3)), p1, t)[0][2] for t in np.linspace(0, 2 * math.pi / w, 721))
+    assert z_bottom == pytest.approx(p0["zc0"], abs=1e-9)  # the centre's lowest point is the old start height
+    with pytest.raises(ValueError, match="only mode oscillation has an orbit"):
+        Case.model_validate({**base.model_dump(), "kinematics": {"mode": "linear", "speed_m_s": 2, "penetration_mm": 4,
+                                                                 "travel_mm": 12, "penetration_at": "orbit_bottom"}})

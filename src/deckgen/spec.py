@@ -317,6 +317,11 @@ class Kinematics(_Model):
         "fastest forward at the bottom (z = e sin(w t)), and a disc turning with the shaft (spin shaft) moves its lowest "
         "point forward relative to its centre; backward: the mirror turn (z = -e sin(w t)), the lowest point moves "
         "backward as on a rolling disc. Seed 003 does not state the sense. The default is left out of resolved cases.")
+    penetration_at: Literal["start", "orbit_bottom"] = Field(
+        "start", exclude_if=lambda v: v == "start", json_schema_extra={"unit": "token"}, description="oscillation: where "
+        "penetration_mm is measured. start: the disc's lowest point is p deep with the orbit's centre at its start "
+        "height, so the disc reaches p + e at the bottom of the orbit; orbit_bottom: the centre path is raised by e "
+        "(e cos of the axis tilt), so p is the deepest cut of the orbit. The default is left out of resolved cases.")
     neighbour_spacing_mm: float | None = _f(
         None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "
         "cut (relieved cutting between neighbours, seed 001); none = an isolated (unrelieved) groove.", gt=0,
@@ -404,6 +409,8 @@ class Case(_Model):
                 )
             if k.mode == "indentation" and k.edge_distance_mm >= sp.width_mm:
                 raise ValueError("kinematics.edge_distance_mm must be less than specimen.width_mm (it is measured from the y min face)")
+            if k.penetration_at != "start" and k.mode != "oscillation":
+                raise ValueError("kinematics.penetration_at: only mode oscillation has an orbit (remove penetration_at)")
             if k.shaft_sense != "forward" and k.mode != "oscillation":
                 raise ValueError("kinematics.shaft_sense: only mode oscillation has a shaft (remove shaft_sense)")
             if k.spin == "shaft" and k.mode != "oscillation":

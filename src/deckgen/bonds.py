@@ -269,6 +269,7 @@ class BondTable:
     length: np.ndarray         # per-type mean bond length [m]
     per_atom: np.ndarray       # bonds per atom
     n_plain_types: int | None = None  # types 1..n_plain_types are ordinary bonds, the rest intra-clump (None: all)
+    strength_factor: np.ndarray | None = None  # per-type mean strength factor of its bonds (1 without scatter)
 
     @property
     def intra_types(self) -> list[int]:
@@ -358,8 +359,8 @@ def make_bond_table(
             return np.bincount(types0, weights=v[sel], minlength=nt) / cnt
 
         rb_t, L_t = mean(rb), mean(L)
-        w_t = mean(sf) if nb_s > 1 else 1.0  # the type's mean strength factor (ordinary bonds only)
-        parts.append((rb_t, L_t, bpm_coefficients(E_b * e_f, stiffness_ratio, sigma_c * s_f * w_t, tau_c * s_f * w_t,
+        w_t = mean(sf) if nb_s > 1 else np.ones(nt)  # the type's mean strength factor (ordinary bonds only)
+        parts.append((rb_t, L_t, w_t, bpm_coefficients(E_b * e_f, stiffness_ratio, sigma_c * s_f * w_t, tau_c * s_f * w_t,
                                                    rb_t, L_t,
                                                    mean(m_eff), mean(I_eff), damping_ratio,
                                                    bending_factor=bending_factor, twisting_factor=twisting_factor)))
@@ -367,15 +368,16 @@ def make_bond_table(
         offset += nt
     n_plain = len(parts[0][0]) if parts and (~mask).any() else 0
     if parts:
-        coeffs = {k: np.concatenate([p[2][k] for p in parts]) for k in COEFF_NAMES}
+        coeffs = {k: np.concatenate([p[3][k] for p in parts]) for k in COEFF_NAMES}
         rb_all = np.concatenate([p[0] for p in parts])
         L_all = np.concatenate([p[1] for p in parts])
+        w_all = np.concatenate([p[2] for p in parts])
     else:  # no bond at all: keep the shapes the plain path gave (empty types)
         coeffs = {k: np.zeros(0) for k in COEFF_NAMES}
-        rb_all, L_all = np.zeros(0), np.zeros(0)
+        rb_all, L_all, w_all = np.zeros(0), np.zeros(0), np.zeros(0)
     per_atom = np.bincount(pairs.ravel(), minlength=len(r))
     return BondTable(pairs=pairs, types=types, coeffs=coeffs, r_bond=rb_all, length=L_all, per_atom=per_atom,
-                     n_plain_types=n_plain)
+                     n_plain_types=n_plain, strength_factor=w_all)
 
 
 def binning_error(x: np.ndarray, r: np.ndarray, table: BondTable, radius_multiplier: float) -> float:

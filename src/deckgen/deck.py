@@ -182,27 +182,24 @@ def cutter_world_points(rel: np.ndarray, path: dict[str, float], t: float) -> np
     """
     X, Y, Z = rel[:, 0], rel[:, 1], rel[:, 2]
     th = path["spin_rate"] * t
+    # a tilted disc (cutter_path's axis_tilt a: axis (0, cos a, sin a)) spins about its own axis and orbits in its
+    # plane: untilt, spin about y, tilt back. a = 0 (every untilted path) gives exactly the plain formulas
     alpha = path.get("axis_tilt", 0.0)
-    if alpha:  # tilted disc: spin about its own axis (0, cos a, sin a), orbit in its plane (cutter_path)
-        ca, sa = math.cos(alpha), math.sin(alpha)
-        Yu, Zu = ca * Y + sa * Z, -sa * Y + ca * Z  # into the disc frame (axis along y)
-        X1 = X * math.cos(th) + Zu * math.sin(th)
-        Z1u = -X * math.sin(th) + Zu * math.cos(th)
-        V, e, w = path["V"], path["ecc"], path["omega"]
-        oz = path.get("sense", 1.0) * e * math.sin(w * t)  # the orbit's offset along the disc frame's z
-        xc = path["xc0"] + V * t + e * (math.cos(w * t) - 1.0)
-        return np.column_stack([xc + X1, path["yc0"] + ca * Yu - sa * (Z1u + oz), path["zc0"] + sa * Yu + ca * (Z1u + oz)])
-    X1 = X * math.cos(th) + Z * math.sin(th)
-    Z1 = -X * math.sin(th) + Z * math.cos(th)
-    if path["rotary_radius"]:
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    Yu, Zu = ca * Y + sa * Z, -sa * Y + ca * Z  # into the disc frame (axis along y)
+    X1 = X * math.cos(th) + Zu * math.sin(th)
+    Z1 = -X * math.sin(th) + Zu * math.cos(th)
+    if path["rotary_radius"]:  # never tilted (cutter_path refuses it)
         r, phi = path["rotary_radius"], path["yaw_rate"] * t
         qx = X1 * math.cos(phi) - (Y - r) * math.sin(phi)
         qy = X1 * math.sin(phi) + (Y - r) * math.cos(phi)
         return np.column_stack([path["axis_x"] + qx, path["axis_y"] + qy, path["zc0"] + Z1])
     V, e, w, ind = path["V"], path["ecc"], path["omega"], path["mode_indent"]
+    oz = (1 - ind) * path.get("sense", 1.0) * e * math.sin(w * t)  # the orbit's offset along the disc frame's z
     xc = path["xc0"] + (1 - ind) * (V * t + e * (math.cos(w * t) - 1.0))
-    zc = path["zc0"] - ind * V * t + (1 - ind) * path.get("sense", 1.0) * e * math.sin(w * t)
-    return np.column_stack([xc + X1, path["yc0"] + Y, zc + Z1])
+    yc = path["yc0"] - sa * oz
+    zc = path["zc0"] - ind * V * t + ca * oz
+    return np.column_stack([xc + X1, yc + ca * Yu - sa * Z1, zc + sa * Yu + ca * Z1])
 
 
 def near_rock_mask(rel: np.ndarray, path: dict[str, float], lo: np.ndarray, hi: np.ndarray, margin: float) -> np.ndarray:
@@ -476,9 +473,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                                "bondable_pairs": n_unbonded + int(len(pairs))}
     if strength is not None:
         plain = np.ones(len(pairs), bool) if intra is None else ~intra
-        t0 = table.types[plain] - 1  # the factor each bond gets in the deck: its type's mean
-        binned = (np.bincount(t0, weights=strength[plain], minlength=table.ntypes)
-                  / np.maximum(np.bincount(t0, minlength=table.ntypes), 1))[t0]
+        binned = table.strength_factor[table.types[plain] - 1]  # the factor each bond gets in the deck: its type's mean
         derived["strength_heterogeneity"] = {
             "weibull_modulus": b.strength_weibull_modulus, "cov_distribution": weibull_cov(b.strength_weibull_modulus),
             "cov_drawn": float(strength[plain].std() / strength[plain].mean()),

@@ -574,23 +574,14 @@ def read_stl_triangles(path: str | Path) -> np.ndarray:
 
 
 def rigid_cutter_position(p0: np.ndarray, path: Mapping[str, float], t: float) -> np.ndarray:
-    """Where points ``p0`` of the disc at rest (centre at the origin, axis y) are at cut time ``t``:
-    centre x_c = x_c0 + V t + e (cos wt - 1), z_c = z_c0 + e sin wt, spin th = spin_rate t about +y
-    (x' = x cos th + z sin th, z' = -x sin th + z cos th, as the LAMMPS cutting deck)."""
-    V, e, w, s = path["V"], path["ecc"], path["omega"], path["spin_rate"]
-    th = s * t
-    x, y, z = p0[..., 0], p0[..., 1], p0[..., 2]
-    spun = np.stack([x * math.cos(th) + z * math.sin(th), y, -x * math.sin(th) + z * math.cos(th)], axis=-1)
-    if path.get("rotary_radius", 0.0):  # p = A + Rz(phi) [(c0 - A) + Ry(th) p0], phi = yaw_rate t
-        phi = path["yaw_rate"] * t
-        q = spun + np.array([path["xc0"] - path["axis_x"], path["yc0"] - path["axis_y"], 0.0])
-        rot = np.stack([q[..., 0] * math.cos(phi) - q[..., 1] * math.sin(phi),
-                        q[..., 0] * math.sin(phi) + q[..., 1] * math.cos(phi), q[..., 2]], axis=-1)
-        return rot + np.array([path["axis_x"], path["axis_y"], path["zc0"]])
-    if path.get("mode_indent", 0.0):
-        return spun + np.array([path["xc0"], path["yc0"], path["zc0"] - V * t])
-    c = np.array([path["xc0"] + V * t + e * (math.cos(w * t) - 1.0), path["yc0"], path["zc0"] + e * math.sin(w * t)])
-    return spun + c
+    """Where points ``p0`` (shape (..., 3)) of the disc at rest (centre at the origin, axis y) are at cut time ``t``:
+    the LAMMPS deck's rigid motion, :func:`deckgen.deck.cutter_world_points` (the stacked move/mesh of this deck
+    reproduce it; spec.json files from before the rotary path lack its keys: no yaw)."""
+    from deckgen.deck import cutter_world_points
+
+    p = np.asarray(p0, dtype=float)
+    full = {"rotary_radius": 0.0, "yaw_rate": 0.0, "axis_x": 0.0, "axis_y": 0.0, "mode_indent": 0.0, **path}
+    return cutter_world_points(p.reshape(-1, 3), full, t).reshape(p.shape)
 
 
 def render_liggghts(case: Case, out: str | Path, *, bed: str = "packing", cache: Path | None = None,

@@ -507,3 +507,58 @@ def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_tren
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2
     up = t.loc["f_rises_with_nu_long"]
     assert up["runs"] == 3 and up["slope"] > 0 and up["sign_as_seed"]
+
+
+def _variant_run(root, name, force, freq_hz, spin="none", sense=None):
+    """A parsed diagnostic run in the `deckgen parse <run> --out <run>/parsed` layout (spec.json in the run folder)."""
+    run = root / name
+    (run / "parsed").mkdir(parents=True)
+    kin = {"mode": "oscillation", "spin": spin, "penetration_at": "orbit_bottom"} | ({"shaft_sense": sense} if sense else {})
+    (run / "spec.json").write_text(json.dumps({"case": {"name": name, "kinematics": kin}, "derived": {"n_shell": 1345}}))
+    omega = 2 * math.pi * freq_hz
+    (run / "parsed" / "summary.json").write_text(json.dumps({
+        "case": name, "n_grains": 1523, "wall_s": 180.0, "force_magnitude_N_mean_steady": force,
+        "steady_start_s": 0.0, "steady_end_s": 0.6 * 2 * math.pi / omega, "omega_rad_s": omega}))
+    return run / "parsed"
+
+
+def test_report_of_diagnostic_variants_takes_the_family_cases_factors(tmp_path):
+    """`report --variants`: a run named '<family case>_<suffix>' is reported under its family case, so the family's
+    trends apply, with its own name and kinematics tokens beside; the frequency trend is the OLS line of the runs."""
+    import pandas as pd
+
+    forces = {"s12": 10.0, "s13": 8.0, "s14": 7.0}
+    dirs = [_variant_run(tmp_path, f"odc_red_{s}_nospin_bottom", f, fz)
+            for (s, f), fz in zip(forces.items(), (180, 240, 270))]
+    rc = fam.main(["report", "--variants", "--family", "odc", "--index", str(ROOT / "cases/odc/index.csv"),
+                   "--out", str(tmp_path / "out"), *map(str, dirs)])
+    assert rc == 0
+    t = pd.read_csv(tmp_path / "out" / "family_table.csv")
+    assert list(t["case"]) == ["odc_red_s12", "odc_red_s13", "odc_red_s14"]
+    assert list(t["variant_case"]) == [f"odc_red_{s}_nospin_bottom" for s in forces]
+    assert list(t["frequency_full_hz"]) == [45.0, 60.0, 67.5]
+    assert set(t["spin"]) == {"none"} and set(t["shaft_sense"]) == {"forward"} and set(t["penetration_at"]) == {"orbit_bottom"}
+    assert list(t["n_shell"]) == [1345] * 3 and t["cycles_in_window_1"].tolist() == pytest.approx([0.6] * 3)
+    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend").loc["f_falls_with_freq_nu_lt_1_half_cycle"]
+    x, y = [45.0, 60.0, 67.5], list(forces.values())
+    slope = float(np.polyfit(x, y, 1)[0])
+    y0 = np.mean(y) + slope * (22.5 - np.mean(x))
+    assert tr["runs"] == 3 and tr["slope"] == pytest.approx(slope)
+    assert tr["change_1"] == pytest.approx(slope * 45.0 / y0)
+
+
+def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
+    index = str(ROOT / "cases/odc/index.csv")
+    stray = _variant_run(tmp_path, "odc_red_s99_nospin", 1.0, 90)
+    with pytest.raises(SystemExit) as exc:
+        fam.main(["report", "--variants", "--family", "odc", "--index", index, "--out", str(tmp_path / "o"), str(stray)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "odc_red_s99_nospin" in err and "summary.json" in err and "fix: name the diagnostic case" in err
+    a = _variant_run(tmp_path, "odc_red_s12_nospin", 1.0, 180)
+    b = _variant_run(tmp_path, "odc_red_s12_backward", 2.0, 180, spin="shaft", sense="backward")
+    with pytest.raises(ValueError, match="one variant per report"):
+        fam.family_table(index, [a, b], variants=True)
+    # a longer family case wins over its prefix: odc_red_s11_long_x_y is a variant of odc_red_s11_long
+    c = _variant_run(tmp_path, "odc_red_s11_long_nospin_bottom", 20.0, 90)
+    assert list(fam.family_table(index, [c], variants=True)["case"]) == ["odc_red_s11_long"]

@@ -751,20 +751,51 @@ TABLE_FIELDS = [
 ]
 
 
-def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
-    """One row per run of a family: its factors (index.csv), grains, wall time and force/damage metrics."""
+#: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them.
+VARIANT_TOKENS = {"spin": None, "shaft_sense": "forward", "penetration_at": "start"}
+
+
+def _variant_base(case: str, known: "set[str]", where: Path) -> str:
+    """The family case a diagnostic variant ``<family case>_<suffix>`` was made from: the longest case of the index
+    that ``case`` starts with, followed by ``_``."""
+    bases = [c for c in known if case.startswith(c + "_")]
+    if not bases:
+        raise ValueError(f"{where}: case {case!r} is not a variant '<family case>_<suffix>' of any case of the index "
+                         "(fix: name the diagnostic case after the family case it changes)")
+    return max(bases, key=len)
+
+
+def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants: bool = False) -> "Any":
+    """One row per run of a family: its factors (index.csv), grains, wall time and force/damage metrics.
+
+    ``variants``: the runs are diagnostic variants of family cases (e.g. ``odc_red_s12_nospin_bottom``, a copy of
+    ``odc_red_s12`` with other kinematics): each row takes the factors of its family case, whose name stays in
+    ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case`` and the kinematics
+    tokens of :data:`VARIANT_TOKENS` from its spec.json."""
     import json
 
     import pandas as pd
 
     idx = pd.read_csv(index_csv, keep_default_na=False)
+    known = set(idx["case"])
     rows = []
     for d in map(Path, parsed_dirs):
-        s = json.loads((d / "summary.json").read_text())
+        summary = d / "summary.json"
+        if not summary.is_file():
+            raise ValueError(f"{d}: no summary.json (fix: pass parsed run folders, made by `deckgen parse`)")
+        s = json.loads(summary.read_text())
         row = {k: s.get(k, float("nan")) for k in TABLE_FIELDS}
-        spec_json = d.parent / "run" / "spec.json"  # the run folder beside parsed/ (deckgen's layout)
-        derived = json.loads(spec_json.read_text()).get("derived", {}) if spec_json.is_file() else {}
+        # the run folder beside parsed/ (the workflow's layout), or parsed/ inside the run folder (`deckgen parse <run>
+        # --out <run>/parsed`)
+        spec_json = next((p for p in (d.parent / "run" / "spec.json", d.parent / "spec.json") if p.is_file()), None)
+        spec = json.loads(spec_json.read_text()) if spec_json else {}
+        derived = spec.get("derived", {})
         row["n_shell"] = derived.get("n_shell", float("nan"))
+        if variants:
+            kin = spec.get("case", {}).get("kinematics", {})
+            row["variant_case"] = s["case"]
+            row.update({k: kin.get(k, default) for k, default in VARIANT_TOKENS.items()})
+            s = {**s, "case": _variant_base(s["case"], known, summary)}
         try:
             row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)
         except (KeyError, TypeError, ValueError):
@@ -775,7 +806,12 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path]) -> "Any":
         except (TypeError, ValueError, ZeroDivisionError):
             row["lateral_to_normal_ratio_1"] = float("nan")
         rows.append({"case": s["case"], **row})
-    runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1"])
+    extra = ["variant_case", *VARIANT_TOKENS] if variants else []
+    runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1",
+                                       *extra])
+    if variants and runs["case"].duplicated().any():
+        dup = sorted(runs.loc[runs["case"].duplicated(keep=False), "variant_case"])
+        raise ValueError(f"{', '.join(dup)}: variants of one family case in one report (fix: one variant per report)")
     return _with_index_factors(idx, runs)
 
 
@@ -1010,8 +1046,9 @@ def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
     return files
 
 
-def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], out: str | Path) -> Path:
-    return report_table(family, family_table(index_csv, parsed_dirs), out)
+def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], out: str | Path,
+           variants: bool = False) -> Path:
+    return report_table(family, family_table(index_csv, parsed_dirs, variants=variants), out)
 
 
 def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None) -> "Any":
@@ -1061,6 +1098,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--family", choices=list(FAMILIES), help="report: the family")
     p.add_argument("--index", help="report: the family's index.csv")
     p.add_argument("--out", help="report: output folder (family_table.csv, plots/)")
+    p.add_argument("--variants", action="store_true", help="report: the runs are diagnostic variants of family cases "
+                   "('<family case>_<suffix>', one per family case): rows take their family case's factors and name, with "
+                   "variant_case, spin, shaft_sense and penetration_at beside")
     p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json); combine: family_table.csv files")
     args = p.parse_intermixed_args(argv)  # run folders may follow the options, as in rules/families.smk
     if args.command == "combine":
@@ -1079,7 +1119,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "report":
         if not (args.family and args.index and args.out):
             p.error("report needs --family, --index and --out")
-        path = report(args.family, args.index, args.parsed, args.out)
+        try:
+            path = report(args.family, args.index, args.parsed, args.out, variants=args.variants)
+        except ValueError as exc:
+            p.error(f"report: {exc}")
         print(f"wrote {path} ({len(args.parsed)} runs) and plots")
         return 0
     root = _root(args.root)

@@ -751,8 +751,9 @@ TABLE_FIELDS = [
 ]
 
 
-#: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them.
-VARIANT_TOKENS = {"spin": None, "shaft_sense": "forward", "penetration_at": "start"}
+#: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them
+#: (a resolved case leaves some out at their defaults, which come from the spec).
+VARIANT_TOKENS = ("spin", "shaft_sense", "penetration_at")
 
 
 def _variant_base(case: str, known: "set[str]", where: Path) -> str:
@@ -776,6 +777,8 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     import pandas as pd
 
+    from deckgen.spec import Kinematics
+
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
     rows = []
@@ -794,7 +797,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
         if variants:
             kin = spec.get("case", {}).get("kinematics", {})
             row["variant_case"] = s["case"]
-            row.update({k: kin.get(k, default) for k, default in VARIANT_TOKENS.items()})
+            row.update({k: kin.get(k, Kinematics.model_fields[k].default) for k in VARIANT_TOKENS})
             s = {**s, "case": _variant_base(s["case"], known, summary)}
         try:
             row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)

@@ -275,6 +275,31 @@ def fixed_face_boxes(sp: CuttingBlock, reg: Any, slab: float, pad: float) -> lis
     return faces
 
 
+def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float]) -> list[dict[str, Any]]:
+    """Deck variables of ``cutter.surface: smooth``: the cone disc as a LAMMPS ``region cone`` along y (large face
+    at the disc centre, small face at +thickness), turned into place by the region's ``rotate``: by the constant
+    tilt of the built disc's axis about x, or, upright, by the spin angle. A region turns about one axis only, so a
+    tilted smooth cone carries no spin; the spec admits that only without cutter friction or with spin none, where a
+    surface of revolution turning about its own axis exerts the same forces as a still one."""
+    prof = np.asarray(cutter_profile(case), dtype=float)
+    a_lo, a_hi = float(prof[:, 1].min()), float(prof[:, 1].max())
+    r_lo = float(prof[np.isclose(prof[:, 1], a_lo), 0].max())
+    r_hi = float(prof[np.isclose(prof[:, 1], a_hi), 0].max())
+    if abs(a_lo) > 1e-12 or not r_lo > r_hi > 0:
+        raise SpecError("cutter.surface: smooth needs the cone disc's large face at its centre (fix: tip_radius_mm 0)")
+    ax = np.asarray(mesh.metadata.get("deckgen_axis", (0.0, 1.0, 0.0)), dtype=float)
+    if abs(ax[0]) > 1e-12:
+        raise SpecError("cutter.surface: smooth: the disc axis leans along x, which a region about x cannot follow "
+                        "(fix: surface shell)")
+    tilt = math.atan2(ax[2], ax[1])
+    out = [_var("cone_r_lo", r_lo, "smooth cone: radius of the large face (the rim)", "m"),
+           _var("cone_r_hi", r_hi, "smooth cone: radius of the small face", "m"),
+           _var("cone_h", a_hi - a_lo, "smooth cone: thickness along the axis", "m")]
+    if abs(tilt) > 1e-12:
+        out.append(_var("cone_tilt", tilt, "smooth cone: constant turn of the region about x (the disc's tilt)", "rad"))
+    return out
+
+
 def cutter_path(case: Case, R: float, axis: np.ndarray | None = None) -> dict[str, float]:
     """Initial centre, duration and motion parameters of the cutter (SI).
 
@@ -568,12 +593,16 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         R = files["summary"]["diameter_m"] / 2.0
         path = cutter_path(case, R, axis=files["mesh"].metadata.get("deckgen_axis"))
         rs = case.cutter.shell_radius_mm * MM
-        if rs > 0.5 * float(r.min()):
+        smooth = case.cutter.surface == "smooth"
+        if smooth:
+            rs = 0.0
+        elif rs > 0.5 * float(r.min()):
             raise SpecError(f"cutter.shell_radius_mm: {case.cutter.shell_radius_mm:g} mm is more than half the smallest "
                             f"grain radius (fix: use <= {0.5 * float(r.min()) / MM:.3g} mm)")
-        pts = shell_points(files["shell_mesh"], case.cutter.shell_spacing * 2 * rs, seed=case.packing.seed)
+        pts = (np.empty((0, 3)) if smooth
+               else shell_points(files["shell_mesh"], case.cutter.shell_spacing * 2 * rs, seed=case.packing.seed))
         n_shell_full = len(pts)
-        if case.cutter.shell_coverage == "near_rock":
+        if case.cutter.shell_coverage == "near_rock" and not smooth:
             margin = (case.cutter.shell_margin_mm * MM if case.cutter.shell_margin_mm is not None
                       else 6.0 * float(r_full.max()))
             lo_b, hi_b = (atoms.x - r[:, None]).min(axis=0), (atoms.x + r[:, None]).max(axis=0)
@@ -590,8 +619,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         rho_all = np.concatenate([np.full(len(r), rho), np.full(n_shell, SHELL_DENSITY)])
         types = np.concatenate([types, np.full(n_shell, 2)])
         n_atom_types = 2
-        lo = np.minimum(box[:, 0], pts.min(axis=0) - pad)
-        hi = np.maximum(box[:, 1], pts.max(axis=0) + pad)
+        body = pts if n_shell else np.asarray(files["mesh"].vertices) + centre  # the smooth cone: its own vertices
+        lo = np.minimum(box[:, 0], body.min(axis=0) - pad)
+        hi = np.maximum(box[:, 1], body.max(axis=0) + pad)
         # room for the whole motion
         lo[0] = min(lo[0], path["xc0"] - R - 2 * path["ecc"] - pad)
         hi[0] = max(hi[0], path["xc0"] + (0 if path["mode_indent"] else path["travel"]) + R + 2 * path["ecc"] + pad)
@@ -623,6 +653,12 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             _var("nsteps", steps, "steps of the cut", "steps"),
             _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
         ]
+        ctx["smooth"], ctx["smooth_rotate"] = smooth, None
+        if smooth:
+            variables += smooth_cone_variables(case, files["mesh"], path)
+            ctx["smooth_rotate"] = ("tilt" if any(v["name"] == "cone_tilt" for v in variables)
+                                    else "spin" if path["spin_rate"] != 0 else None)
+            derived["smooth_cone"] = {v["name"]: float(v["value"]) for v in variables if v["name"].startswith("cone_")}
         fixed_slab = 2.0 * float(r_full.max())
         faces = fixed_face_boxes(sp, reg, fixed_slab, pad)
         ctx["fixed_faces"] = faces

@@ -285,6 +285,14 @@ class Cutter(_Model):
         0.0, "deg", "Tilt of the disc axis about the cut direction (x): the rim leans toward +y for positive values "
         "(0 = upright; discrepancy effect 'tilt').", ge=-30, le=30,
     )
+    surface: Literal["shell", "smooth"] = Field(
+        "shell", exclude_if=lambda v: v == "shell", json_schema_extra={"unit": "token"}, description="LAMMPS: how the "
+        "cutter touches the grains. shell: a rigid shell of spheres on the STL (any cutter, bumps of the shell's size); "
+        "smooth: a moving LAMMPS cone region (fix wall/gran/region), a surface without bumps that passes only the "
+        "contact model's normal and friction forces, as a triangle-mesh wall does in EDEM or LIGGGHTS. smooth needs "
+        "kind cone_disc with tip_radius_mm 0, and a disc that spins about a tilted axis only without friction "
+        "(contact.cutter_friction 0), because a region turns about one axis only. The default is left out of "
+        "resolved cases.")
 
 
 class Kinematics(_Model):
@@ -417,6 +425,24 @@ class Case(_Model):
                 raise ValueError("kinematics.spin: shaft needs mode oscillation (use none or rolling)")
             if self.cutter.kind == "cone_disc" and self.cutter.small_diameter_mm >= self.cutter.diameter_mm:
                 raise ValueError("cutter.small_diameter_mm must be less than cutter.diameter_mm")
+            cu = self.cutter
+            if cu.surface == "smooth":
+                if cu.kind != "cone_disc" or cu.tip_radius_mm != 0:
+                    raise ValueError("cutter.surface: smooth is a LAMMPS cone region; it needs kind cone_disc with "
+                                     "tip_radius_mm 0 (fix: use surface shell for this cutter)")
+                if cu.wear_flat_mm != 0:
+                    raise ValueError("cutter.surface: smooth has no worn land (fix: wear_flat_mm 0 or surface shell)")
+                if self.engine != "lammps":
+                    raise ValueError("cutter.surface: smooth is a LAMMPS region wall (fix: engine lammps, or leave "
+                                     "surface out: LIGGGHTS decks use the STL mesh itself)")
+                if k.mode == "rotary":
+                    raise ValueError("cutter.surface: smooth does not follow a rotary path (fix: surface shell)")
+                tilted = (cu.clearance_angle_deg != 0) or (cu.tilt_deg != 0)
+                if tilted and k.spin != "none" and self.contact.cutter_friction != 0:
+                    raise ValueError("cutter.surface: smooth: a LAMMPS region turns about one axis, so a tilted disc "
+                                     "(clearance_angle_deg or tilt_deg not 0) cannot also spin with friction (fix: "
+                                     "contact.cutter_friction 0, where the spin of a smooth cone does not matter, "
+                                     "kinematics.spin none, or surface shell)")
         return self
 
 

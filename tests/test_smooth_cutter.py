@@ -16,8 +16,8 @@ from deckgen.spec import SpecError, load_case, resolved_dict
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ROOT / "tests" / "data" / "cases"
 
-# the tiny oscillating cut with a small cone disc (12/6 mm, rake 30, clearance 9 deg, sharp), frictionless
-CONE = {"kind": "cone_disc", "diameter_mm": 12.0, "small_diameter_mm": 6.0, "rake_angle_deg": 30.0,
+# the tiny oscillating cut with a small cone disc (12/8 mm, rake 30, clearance 9 deg, sharp), frictionless
+CONE = {"kind": "cone_disc", "diameter_mm": 12.0, "small_diameter_mm": 8.0, "rake_angle_deg": 30.0,
         "clearance_angle_deg": 9.0, "tip_radius_mm": 0.0, "surface": "smooth"}
 SMOOTH = {"cutter": CONE, "contact": {"cutter_friction": 0.0}, "kinematics": {"spin": "shaft"}}
 
@@ -65,8 +65,8 @@ def test_smooth_deck_has_a_region_cone_and_no_shell(tmp_path):
     assert d["n_shell"] == 0
     cone = d["smooth_cone"]
     assert cone["cone_r_lo"] == pytest.approx(6e-3, rel=1e-9)
-    assert cone["cone_r_hi"] == pytest.approx(3e-3, rel=1e-9)
-    assert cone["cone_h"] == pytest.approx(3e-3 * math.tan(math.radians(60.0)), rel=1e-9)  # (R - r) tan(90 - rake)
+    assert cone["cone_r_hi"] == pytest.approx(4e-3, rel=1e-9)
+    assert cone["cone_h"] == pytest.approx(2e-3 * math.tan(math.radians(60.0)), rel=1e-9)  # (R - r) tan(90 - rake)
     assert cone["cone_tilt"] == pytest.approx(-math.radians(9.0), rel=1e-9)  # the clearance tilt, rim toward -y
     deck = (out / "in.deck").read_text()
     assert "region          disc cone y ${xc0} ${zc0} ${cone_r_lo} ${cone_r_hi} ${yc0} ${cone_y1} side out" in deck
@@ -79,6 +79,11 @@ def test_smooth_deck_has_a_region_cone_and_no_shell(tmp_path):
                         progress=False)
     assert "cone_tilt" not in spec0["derived"]["smooth_cone"]
     assert "rotate v_rot ${xc0} ${yc0} ${zc0} 0 1 0" in (tmp_path / "u" / "in.deck").read_text()
+
+
+def test_smooth_cone_narrower_than_two_grain_diameters_is_refused(tmp_path):
+    with pytest.raises(SpecError, match="less than two grain diameters"):  # 3 mm < 4 x 0.9 mm
+        render_case(_case(cutter={"small_diameter_mm": 6.0}), tmp_path / "d", cache=tmp_path / "cache", progress=False)
 
 
 @pytest.mark.engine

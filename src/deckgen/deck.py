@@ -275,7 +275,7 @@ def fixed_face_boxes(sp: CuttingBlock, reg: Any, slab: float, pad: float) -> lis
     return faces
 
 
-def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float]) -> list[dict[str, Any]]:
+def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float], r_grain_max: float) -> list[dict[str, Any]]:
     """Deck variables of ``cutter.surface: smooth``: the cone disc as a LAMMPS ``region cone`` along y (large face
     at the disc centre, small face at +thickness), turned into place by the region's ``rotate``: by the constant
     tilt of the built disc's axis about x, or, upright, by the spin angle. A region turns about one axis only, so a
@@ -287,6 +287,13 @@ def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float]) -> list
     r_hi = float(prof[np.isclose(prof[:, 1], a_hi), 0].max())
     if abs(a_lo) > 1e-12 or not r_lo > r_hi > 0:
         raise SpecError("cutter.surface: smooth needs the cone disc's large face at its centre (fix: tip_radius_mm 0)")
+    # LAMMPS 22Jul2025 gives an exterior cone contact the wall radius -2 rho (rho: the cone's local radius), and the
+    # granular wall model takes R_eff = r (-2 rho) / (r - 2 rho): a grain as wide as the cone is there divides by
+    # zero. Keep the cone's smallest radius at least two grain diameters (then R_eff is at most 8/7 of r).
+    if r_hi < 4.0 * r_grain_max:
+        raise SpecError(f"cutter.surface: smooth: the cone's small face (radius {r_hi / MM:.3g} mm) is less than two "
+                        f"grain diameters ({4 * r_grain_max / MM:.3g} mm); the engine's cone wall is not reliable there "
+                        "(fix: larger small_diameter_mm, smaller grains or surface shell)")
     ax = np.asarray(mesh.metadata.get("deckgen_axis", (0.0, 1.0, 0.0)), dtype=float)
     if abs(ax[0]) > 1e-12:
         raise SpecError("cutter.surface: smooth: the disc axis leans along x, which a region about x cannot follow "
@@ -655,7 +662,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         ]
         ctx["smooth"], ctx["smooth_rotate"] = smooth, None
         if smooth:
-            variables += smooth_cone_variables(case, files["mesh"], path)
+            variables += smooth_cone_variables(case, files["mesh"], path, float(r_full.max()))
             ctx["smooth_rotate"] = ("tilt" if any(v["name"] == "cone_tilt" for v in variables)
                                     else "spin" if path["spin_rate"] != 0 else None)
             derived["smooth_cone"] = {v["name"]: float(v["value"]) for v in variables if v["name"].startswith("cone_")}

@@ -509,12 +509,13 @@ def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_tren
     assert up["runs"] == 3 and up["slope"] > 0 and up["sign_as_seed"]
 
 
-def _variant_run(root, name, force, freq_hz, spin="none", sense=None):
+def _variant_run(root, name, force, freq_hz, spin="none", sense=None, cutter=None, contact=None):
     """A parsed diagnostic run in the `deckgen parse <run> --out <run>/parsed` layout (spec.json in the run folder)."""
     run = root / name
     (run / "parsed").mkdir(parents=True)
     kin = {"mode": "oscillation", "spin": spin, "penetration_at": "orbit_bottom"} | ({"shaft_sense": sense} if sense else {})
-    (run / "spec.json").write_text(json.dumps({"case": {"name": name, "kinematics": kin}, "derived": {"n_shell": 1345}}))
+    case = {"name": name, "kinematics": kin} | ({"cutter": cutter} if cutter else {}) | ({"contact": contact} if contact else {})
+    (run / "spec.json").write_text(json.dumps({"case": case, "derived": {"n_shell": 1345}}))
     omega = 2 * math.pi * freq_hz
     (run / "parsed" / "summary.json").write_text(json.dumps({
         "case": name, "n_grains": 1523, "wall_s": 180.0, "force_magnitude_N_mean_steady": force,
@@ -539,12 +540,25 @@ def test_report_of_diagnostic_variants_takes_the_family_cases_factors(tmp_path):
     assert list(t["frequency_full_hz"]) == [45.0, 60.0, 67.5]
     assert set(t["spin"]) == {"none"} and set(t["shaft_sense"]) == {"forward"} and set(t["penetration_at"]) == {"orbit_bottom"}
     assert list(t["n_shell"]) == [1345] * 3 and t["cycles_in_window_1"].tolist() == pytest.approx([0.6] * 3)
+    assert set(t["cutter_surface"]) == {"shell"} and set(t["cutter_friction_1"]) == {0.3}  # the spec's defaults
     tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend").loc["f_falls_with_freq_nu_lt_1_half_cycle"]
     x, y = [45.0, 60.0, 67.5], list(forces.values())
     slope = float(np.polyfit(x, y, 1)[0])
     y0 = np.mean(y) + slope * (22.5 - np.mean(x))
     assert tr["runs"] == 3 and tr["slope"] == pytest.approx(slope)
     assert tr["change_1"] == pytest.approx(slope * 45.0 / y0)
+
+
+def test_report_of_variants_carries_the_cutter_surface_and_friction(tmp_path):
+    import pandas as pd
+
+    d = _variant_run(tmp_path, "odc_red_s16_long_smooth_f0", 20.0, 90, spin="shaft",
+                     cutter={"kind": "cone_disc", "surface": "smooth"}, contact={"cutter_friction": 0.0})
+    assert fam.main(["report", "--variants", "--family", "odc", "--index", str(ROOT / "cases/odc/index.csv"),
+                     "--out", str(tmp_path / "out"), str(d)]) == 0
+    t = pd.read_csv(tmp_path / "out" / "family_table.csv")
+    assert list(t["case"]) == ["odc_red_s16_long"]  # the longest family case the name starts with
+    assert list(t["cutter_surface"]) == ["smooth"] and list(t["cutter_friction_1"]) == [0.0]
 
 
 def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):

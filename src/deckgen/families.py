@@ -754,6 +754,8 @@ TABLE_FIELDS = [
 #: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them
 #: (a resolved case leaves some out at their defaults, which come from the spec).
 VARIANT_TOKENS = ("spin", "shaft_sense", "penetration_at")
+# (column, section of the case, field): the cutter's surface and friction of a variant beside its kinematics
+VARIANT_CUTTER = (("cutter_surface", "cutter", "surface"), ("cutter_friction_1", "contact", "cutter_friction"))
 
 
 def _variant_base(case: str, known: "set[str]", where: Path) -> str:
@@ -771,13 +773,14 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     ``variants``: the runs are diagnostic variants of family cases (e.g. ``odc_red_s12_nospin_bottom``, a copy of
     ``odc_red_s12`` with other kinematics): each row takes the factors of its family case, whose name stays in
-    ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case`` and the kinematics
-    tokens of :data:`VARIANT_TOKENS` from its spec.json."""
+    ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case``, the kinematics
+    tokens of :data:`VARIANT_TOKENS` and the cutter's surface and friction (:data:`VARIANT_CUTTER`) from its
+    spec.json."""
     import json
 
     import pandas as pd
 
-    from deckgen.spec import Kinematics
+    from deckgen.spec import Contact, Cutter, Kinematics
 
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
@@ -798,6 +801,9 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             kin = spec.get("case", {}).get("kinematics", {})
             row["variant_case"] = s["case"]
             row.update({k: kin.get(k, Kinematics.model_fields[k].default) for k in VARIANT_TOKENS})
+            models = {"cutter": Cutter, "contact": Contact}
+            row.update({col: spec.get("case", {}).get(sec, {}).get(f, models[sec].model_fields[f].default)
+                        for col, sec, f in VARIANT_CUTTER})
             s = {**s, "case": _variant_base(s["case"], known, summary)}
         try:
             row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)
@@ -809,7 +815,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
         except (TypeError, ValueError, ZeroDivisionError):
             row["lateral_to_normal_ratio_1"] = float("nan")
         rows.append({"case": s["case"], **row})
-    extra = ["variant_case", *VARIANT_TOKENS] if variants else []
+    extra = ["variant_case", *VARIANT_TOKENS, *(c[0] for c in VARIANT_CUTTER)] if variants else []
     runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1",
                                        *extra])
     if variants and runs["case"].duplicated().any():

@@ -275,12 +275,15 @@ def fixed_face_boxes(sp: CuttingBlock, reg: Any, slab: float, pad: float) -> lis
     return faces
 
 
-def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float], r_grain_max: float) -> list[dict[str, Any]]:
+def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float],
+                          r_grain_max: float) -> tuple[list[dict[str, Any]], str | None]:
     """Deck variables of ``cutter.surface: smooth``: the cone disc as a LAMMPS ``region cone`` along y (large face
     at the disc centre, small face at +thickness), turned into place by the region's ``rotate``: by the constant
     tilt of the built disc's axis about x, or, upright, by the spin angle. A region turns about one axis only, so a
     tilted smooth cone carries no spin; the spec admits that only without cutter friction or with spin none, where a
-    surface of revolution turning about its own axis exerts the same forces as a still one."""
+    surface of revolution turning about its own axis exerts the same forces as a still one.
+
+    Returns the deck variables and what the region's ``rotate`` turns by: ``"tilt"``, ``"spin"`` or None."""
     prof = np.asarray(cutter_profile(case), dtype=float)
     a_lo, a_hi = float(prof[:, 1].min()), float(prof[:, 1].max())
     r_lo = float(prof[np.isclose(prof[:, 1], a_lo), 0].max())
@@ -304,7 +307,8 @@ def smooth_cone_variables(case: Case, mesh: Any, path: dict[str, float], r_grain
            _var("cone_h", a_hi - a_lo, "smooth cone: thickness along the axis", "m")]
     if abs(tilt) > 1e-12:
         out.append(_var("cone_tilt", tilt, "smooth cone: constant turn of the region about x (the disc's tilt)", "rad"))
-    return out
+        return out, "tilt"
+    return out, ("spin" if path["spin_rate"] != 0 else None)
 
 
 def cutter_path(case: Case, R: float, axis: np.ndarray | None = None) -> dict[str, float]:
@@ -662,10 +666,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         ]
         ctx["smooth"], ctx["smooth_rotate"] = smooth, None
         if smooth:
-            variables += smooth_cone_variables(case, files["mesh"], path, float(r_full.max()))
-            ctx["smooth_rotate"] = ("tilt" if any(v["name"] == "cone_tilt" for v in variables)
-                                    else "spin" if path["spin_rate"] != 0 else None)
-            derived["smooth_cone"] = {v["name"]: float(v["value"]) for v in variables if v["name"].startswith("cone_")}
+            cone_vars, ctx["smooth_rotate"] = smooth_cone_variables(case, files["mesh"], path, float(r_full.max()))
+            variables += cone_vars
+            derived["smooth_cone"] = {v["name"]: float(v["value"]) for v in cone_vars}
         fixed_slab = 2.0 * float(r_full.max())
         faces = fixed_face_boxes(sp, reg, fixed_slab, pad)
         ctx["fixed_faces"] = faces

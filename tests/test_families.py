@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 120 + 2 * len(NAMES)  # 120 case files + index.csv and README.md per family
+    assert len(files) == 126 + 2 * len(NAMES)  # 126 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -52,7 +52,7 @@ def test_case_counts_per_family():
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
-        ("odc", "full"): 10, ("odc", "reduced"): 22,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts
+        ("odc", "full"): 10, ("odc", "reduced"): 28,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 smooth long cuts
     }
 
 
@@ -67,7 +67,7 @@ def test_every_family_case_validates_and_its_path_fits_the_block(family, scale):
         cutter_path(case, case.cutter.diameter_mm * MM / 2)
         est = fam.estimate(case.model_dump())
         assert est["steps_est"] < case.run.max_steps, path
-        if scale == "reduced" and path.stem.endswith("_long"):  # the supplementary long ODC cuts: 3.7x the travel
+        if scale == "reduced" and path.stem.endswith(("_long", "_long_smoothcone")):  # the long ODC cuts: 3.7x the travel
             assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 600_000, (path, est)
             assert est["particle_steps_est"] <= 2e9, (path, est)  # <= ~17 min at 2 M particle-steps/s
         elif scale == "reduced" and path.stem.endswith("_x1"):  # the ODC cuts at the seed's speed: 4x the steps
@@ -189,7 +189,7 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):
         k = 1 if c.name.endswith("_x1") else 4  # the x1 cuts keep the seed's speed and frequency
-        name = c.name.removesuffix("_x1")
+        name = c.name.removesuffix("_x1").removesuffix("_smoothcone").removesuffix("_long")
         if name in sup:  # no full-scale twin: the stated seed-unit values x4
             e, f, v = sup[name]
             assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(k * v), pytest.approx(k * f))
@@ -473,7 +473,7 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
     n = sum(len(v) for v in fam.TREND_SUBSETS.values())
-    assert n == 26
+    assert n == 18
     for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
         assert f"{rule} {count}" in text, (rule, count, text[-1500:])
     for names in fam.TREND_SUBSETS.values():
@@ -507,6 +507,84 @@ def test_odc_long_cuts_hold_more_than_a_cycle_and_stay_out_of_the_frequency_tren
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2
     up = t.loc["f_rises_with_nu_long"]
     assert up["runs"] == 3 and up["slope"] > 0 and up["sign_as_seed"]
+
+
+
+def test_odc_smooth_long_cuts_are_the_long_cuts_on_an_upright_smooth_cone():
+    """odc_red_s<sim>_long_smoothcone: the 44 mm cut with a smooth region cone, clearance 0, the disc turning with the
+    shaft and the depth at the orbit's bottom; everything else as the family's long cut. They alone feed the
+    *_smooth trends (whole-cycle windows slid over the steady window) and are the ODC trend subset."""
+    import pandas as pd
+
+    cases = {c.name: c for c in fam.odc()}
+    smooth = [cases[f"odc_red_s{sim}_long_smoothcone"] for sim in fam.ODC_SMOOTH_SIMS]
+    assert set(fam.TREND_SUBSETS["odc"]) == {c.name for c in smooth}
+    for c in smooth:
+        d, kin = c.data, c.data["kinematics"]
+        assert d["cutter"]["surface"] == "smooth" and d["cutter"]["clearance_angle_deg"] == 0
+        assert d["contact"]["cutter_friction"] == 0.3 and kin["travel_mm"] == 44
+        assert c.factors["cutter_surface"] == "smooth" and c.factors["clearance_angle_deg"] == 0
+        if kin["mode"] == "oscillation":
+            assert kin["spin"] == "shaft" and kin["penetration_at"] == "orbit_bottom"
+            assert c.factors["penetration_at"] == "orbit_bottom"
+        long = cases.get(c.name.removesuffix("_smoothcone"))
+        if long is not None:  # sims 10, 11, 16 have a shell long cut: the same apart from cutter and depth reading
+            assert {k: v for k, v in d.items() if k not in ("name", "cutter", "kinematics")} == \
+                {k: v for k, v in long.data.items() if k not in ("name", "cutter", "kinematics")}
+            assert {k: v for k, v in kin.items() if k != "penetration_at"} == long.data["kinematics"]
+    assert cases["odc_red_s10_long"].factors["cutter_surface"] == "shell"
+    rows = []
+    for name, f, nu, ecc, force in [("odc_red_s11_long_smoothcone", 90, 0.884, 0.4, 10.0), ("odc_red_s14_long_smoothcone", 270, 0.295, 0.4, 7.0),
+                                     ("odc_red_s16_long_smoothcone", 90, 3.537, 0.1, 25.0), ("odc_red_s101_long_smoothcone", 180, 1.768, 0.1, 24.0),
+                                     ("odc_red_s103_long_smoothcone", 270, 1.179, 0.1, 25.5), ("odc_red_s11_long", 90, 0.884, 0.4, 99.0),
+                                     ("odc_red_s12", 180, 0.442, 0.4, 30.0), ("odc_red_s13", 240, 0.332, 0.4, 20.0)]:
+        rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu, "speedup_1": 4,
+                     "eccentricity_ratio_1": ecc, "speed_full_m_s": 0.5, "cycles_in_window_1": 0.7 * 44e-3 * f / 2,
+                     "force_magnitude_N_mean_steady": force, "force_magnitude_N_mean_cycles": force,
+                     "force_magnitude_N_mean_cycles_sliding": force})
+    t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")
+    falls, flat, up = (t.loc[k] for k in ("f_falls_with_freq_nu_lt_1_smooth", "f_flat_with_freq_nu_gt_1_smooth", "f_rises_with_nu_smooth"))
+    assert falls["runs"] == 2 and falls["change_1"] == pytest.approx(-0.3, abs=1e-9) and bool(falls["sign_as_seed"])
+    assert flat["runs"] == 3 and flat["p_value"] > 0.05 and bool(flat["sign_as_seed"])
+    assert up["runs"] == 2 and up["slope"] > 0 and bool(up["sign_as_seed"])
+    assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2  # the 12 mm cuts only: neither smooth nor long cuts
+
+
+def test_report_takes_a_renamed_copy_of_a_family_case_only_when_it_is_the_same_case(tmp_path):
+    """--same-as RUN=CASE: a run of a diagnostic file that the generator later took over reports as the family case,
+    checked against the case file through its resolved spec.json; a run that differs is refused with the field."""
+    from deckgen.spec import load_case, resolved_dict
+
+    idx = ROOT / "cases" / "odc" / "index.csv"
+    case = resolved_dict(load_case(ROOT / "cases" / "odc" / "reduced" / "odc_red_s16_long_smoothcone.yaml"))
+
+    def run(name, change=None):
+        c = json.loads(json.dumps({**case, "name": name}))
+        if change:
+            change(c)
+        d = tmp_path / name
+        (d / "parsed").mkdir(parents=True)
+        (d / "spec.json").write_text(json.dumps({"case": c, "derived": {}}))
+        (d / "parsed" / "summary.json").write_text(json.dumps({"case": name, "force_magnitude_N_mean_cycles_sliding": 24.7,
+                                                                "steady_start_s": 0.0055, "steady_end_s": 0.0209,
+                                                                "omega_rad_s": 2 * math.pi * 90}))
+        return d / "parsed"
+
+    same = run("odc_red_s16_long_bottom_c0_smooth")
+    t = fam.family_table(idx, [same], same_as={"odc_red_s16_long_bottom_c0_smooth": "odc_red_s16_long_smoothcone"})
+    assert list(t["case"]) == ["odc_red_s16_long_smoothcone"] and t["cutter_surface"].iloc[0] == "smooth"
+    assert t["force_magnitude_N_mean_cycles_sliding"].iloc[0] == 24.7
+    other = run("odc_red_s16_long_c0_smooth", lambda c: c["kinematics"].update(penetration_at="start"))
+    with pytest.raises(ValueError, match=r"differs from .*odc_red_s16_long_smoothcone.yaml in kinematics.penetration_at"):
+        fam.family_table(idx, [other], same_as={"odc_red_s16_long_c0_smooth": "odc_red_s16_long_smoothcone"})
+    with pytest.raises(ValueError, match="no case 'odc_red_s99'"):
+        fam.family_table(idx, [same], same_as={"odc_red_s16_long_bottom_c0_smooth": "odc_red_s99"})
+    rc = fam.main(["report", "--family", "odc", "--index", str(idx), "--out", str(tmp_path / "rep"), "--same-as",
+                   "odc_red_s16_long_bottom_c0_smooth=odc_red_s16_long_smoothcone", str(same)])
+    assert rc == 0 and (tmp_path / "rep" / "trends.csv").is_file()
+    with pytest.raises(SystemExit):
+        fam.main(["report", "--family", "odc", "--index", str(idx), "--out", str(tmp_path / "rep2"), "--same-as",
+                  "odc_red_s16_long_bottom_c0_smooth", str(same)])
 
 
 def _variant_run(root, name, force, freq_hz, spin="none", sense=None, cutter=None, contact=None):

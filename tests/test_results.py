@@ -510,11 +510,24 @@ def test_whole_cycle_means_remove_the_phase_of_a_partial_cycle_window():
     assert s["cycles_averaged_1"] == 1  # 0.7 * 0.022 s * 90 Hz = 1.39 cycles
     assert s["force_magnitude_N_mean_cycles"] == pytest.approx(10.0, abs=0.01)
     assert abs(s["force_magnitude_N_mean_steady"] - 10.0) > 0.5  # the partial cycle biases the plain mean
+    assert s["force_magnitude_N_mean_cycles_sliding"] == pytest.approx(10.0, abs=0.01)  # every whole-cycle window: 10
+    # a force that grows along the cut (chipping differs along the block): the first whole cycle sees only the
+    # window's start, the sliding windows all of it. Window 5.5-20.9 ms, one cycle 11.1 ms: windows start at
+    # 5.5-9.8 ms, their centres 11.1-15.4 ms, so the sliding mean is the force at 13.25 ms and the first cycle's
+    # the force at 11.1 ms (+ the sine's zero mean)
+    ramp = force + 1000.0 * t
+    s4 = _cutting_summary(pd.DataFrame({"time_s": t, **{q: ramp for q in CUTTING_QUANTITIES}}), spec)
+    t0 = 0.25 * duration
+    assert s4["force_magnitude_N_mean_cycles"] == pytest.approx(10.0 + 1000.0 * (t0 + 0.5 / f_hz), abs=0.02)
+    t_last = 0.95 * duration - 1 / f_hz
+    assert s4["force_magnitude_N_mean_cycles_sliding"] == pytest.approx(10.0 + 1000.0 * ((t0 + t_last) / 2 + 0.5 / f_hz), abs=0.05)
     # no whole cycle in the window: NaN; no oscillation: the steady mean
     short = {**spec, "derived": {**spec["derived"], "steady_window": [0.4, 0.9]}}
     s2 = _cutting_summary(ts[ts.time_s <= 0.01], {**short, "derived": {**short["derived"],
                                                                         "cutter": {**spec["derived"]["cutter"], "duration": 0.01}}})
     assert s2["cycles_averaged_1"] == 0 and np.isnan(s2["force_magnitude_N_mean_cycles"])
+    assert np.isnan(s2["force_magnitude_N_mean_cycles_sliding"])
     lin = {**spec, "derived": {**spec["derived"], "cutter": {**spec["derived"]["cutter"], "ecc": 0.0, "omega": 0.0}}}
     s3 = _cutting_summary(ts, lin)
     assert s3["force_magnitude_N_mean_cycles"] == s3["force_magnitude_N_mean_steady"]
+    assert s3["force_magnitude_N_mean_cycles_sliding"] == s3["force_magnitude_N_mean_steady"]

@@ -527,6 +527,16 @@ ODC_LONG_WINDOW = (0.25, 0.95)
 #: long cuts showed that a fast-turning disc carries a quarter of a sliding one's force (docs/families.md). Same
 #: path per mm of travel, 4x the steps.
 ODC_X1_SIMS = (12, 13, 14, 101, 102, 103)
+#: Supplementary long reduced cuts on a smooth upright cone (names ``odc_red_s<sim>_long_smoothcone``): 44 mm cuts as
+#: ``_long`` with ``cutter.surface: smooth`` (a LAMMPS region cone, no bumps), clearance 0 (an upright disc, the only
+#: one the smooth cone can spin on with friction: a region turns about one axis), the disc turning with the shaft,
+#: cutter friction 0.3 as the family, and the depth read at the bottom of the orbit (``penetration_at: orbit_bottom``,
+#: so the deepest cut is the straight cut's 4 mm). The shell's bumps on a disc spinning at 4x the seed's rim speed
+#: took the nu > 1 force to a third of the straight cut; this set is the one whose whole-cycle means carry the
+#: seed's ODC trends (docs/families.md, sections "A smooth cone" and "The upright smooth cone"). Sims 14, 101, 103
+#: have no long shell cut; their 44 mm cuts are here only.
+ODC_SMOOTH_SIMS = (10, 11, 14, 16, 101, 103)
+SEED003_CLEARANCE_DEG = 9
 
 
 def odc() -> list[CaseDef]:
@@ -536,10 +546,14 @@ def odc() -> list[CaseDef]:
     for scale in SCALES:
         runs = [(row, False) for row in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ())]
         runs = [(row, long, 1.0 if scale == "full" else ODC_SPEEDUP) for row, long in runs]
+        runs = [(row, long, k, False) for row, long, k in runs]
         if scale == "reduced":
-            runs += [(row, True, ODC_SPEEDUP) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
-            runs += [(row, False, 1.0) for row in SEED003_SIMS + ODC_SUPPLEMENTARY if row[0] in ODC_X1_SIMS]
-        for (sim, ecc, rev_s, V, clr), long, k in runs:
+            runs += [(row, True, ODC_SPEEDUP, False) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
+            runs += [(row, False, 1.0, False) for row in SEED003_SIMS + ODC_SUPPLEMENTARY if row[0] in ODC_X1_SIMS]
+            runs += [(row, True, ODC_SPEEDUP, True) for row in SEED003_SIMS + ODC_SUPPLEMENTARY if row[0] in ODC_SMOOTH_SIMS]
+        for (sim, ecc, rev_s, V, clr), long, k, smooth in runs:
+            if smooth:
+                clr = 0
             if scale == "reduced" and sim == 19:
                 continue  # 4.5 rev/s at 0.1 m/s: < 0.3 cycles in a reduced block (docs/families.md)
             e_mm = _r(ecc * ODC_R_MM, 3)
@@ -547,10 +561,13 @@ def odc() -> list[CaseDef]:
             nu = V / (e_mm * 1e-3 * 2 * math.pi * rev_s) if osc else math.inf
             speed, freq = _r(V * k), _r(rev_s * k)
             x1 = scale == "reduced" and k == 1.0
-            name = f"odc_{'full' if scale == 'full' else 'red'}_s{sim}" + ("_long" if long else "") + ("_x1" if x1 else "")
+            name = (f"odc_{'full' if scale == 'full' else 'red'}_s{sim}" + ("_long" if long else "") + ("_x1" if x1 else "")
+                    + ("_smoothcone" if smooth else ""))
             kin: dict[str, Any] = {"mode": "oscillation" if osc else "linear", "speed_m_s": speed, "penetration_mm": 4}
             if osc:
                 kin.update(eccentricity_mm=e_mm, frequency_hz=freq, spin="shaft")
+                if smooth:
+                    kin["penetration_at"] = "orbit_bottom"
             if scale == "full":
                 L, W, H = 70, 70, 20
                 kin.update(travel_mm=40, start_clearance_mm=1)
@@ -578,8 +595,14 @@ def odc() -> list[CaseDef]:
                 if long:
                     outputs["steady_window"] = list(ODC_LONG_WINDOW)
                 if long:
-                    what = (f"Table 5.1 sim {sim}, supplementary LONG cut: {travel} mm of travel, steady window "
+                    what = ((f"Table 5.1 sim {sim}" if sim < 100 else f"supplementary case {sim} (not in Table 5.1)")
+                            + f", supplementary LONG cut: {travel} mm of travel, steady window "
                             f"{ODC_LONG_WINDOW[0]:g}-{ODC_LONG_WINDOW[1]:g} of it")
+                    if smooth:
+                        what += ("; SMOOTH UPRIGHT CONE: region cone instead of the shell of spheres, clearance 0 "
+                                 f"(the seed's {SEED003_CLEARANCE_DEG} deg: a region turns about one axis, so only an "
+                                 "upright smooth disc can spin with the shaft and carry friction)"
+                                 + (", depth p at the bottom of the orbit (penetration_at orbit_bottom)" if osc else ""))
                 elif sim < 100:
                     what = f"Table 5.1 sim {sim}."
                 else:
@@ -612,6 +635,8 @@ def odc() -> list[CaseDef]:
             block = {"length_mm": L, "width_mm": W, "height_mm": H, "fixed_faces": ["zmin", "xmax"]}
             cutter = {"kind": "cone_disc", "diameter_mm": 20, "small_diameter_mm": 10, "clearance_angle_deg": clr,
                       "rake_angle_deg": 30, "tip_radius_mm": 0, "shell_radius_mm": 0.3}
+            if smooth:
+                cutter["surface"] = "smooth"
             data = _cutting(name, rock, packing, bonds, contact, block, cutter, kin, outputs)
             if scale == "full":
                 data["run"] = {"max_steps": _max_steps(data)}
@@ -619,7 +644,8 @@ def odc() -> list[CaseDef]:
                 "rock": rock, "seed_sim": sim, "eccentricity_ratio_1": ecc, "eccentricity_mm": e_mm,
                 "frequency_full_hz": rev_s, "frequency_hz": freq, "speed_full_m_s": V, "speed_m_s": speed,
                 "clearance_angle_deg": clr, "velocity_ratio_nu_1": _r(nu, 3) if osc else "inf",
-                "travel_mm": kin["travel_mm"], "speedup_1": _r(k)}))
+                "travel_mm": kin["travel_mm"], "speedup_1": _r(k), "cutter_surface": cutter.get("surface", "shell"),
+                "penetration_at": kin.get("penetration_at", "start")}))
     return out
 
 
@@ -647,12 +673,11 @@ def case_text(c: CaseDef) -> str:
 
 
 #: reduced cases that carry the trends of issue #4 at the least cost (``family_<family>_trends`` targets):
-#: linear S 25/51/100 at p 6.4 and p 1.9/6.4/7.6 at S 100; ODC no oscillation, nu < 1 at 45/60/67.5 rev/s,
-#: nu = 3.5 and the supplementary nu > 1 series at 45/60/67.5 rev/s; rotary r 250/1000/3000; indentation concrete D 150 at t 15/20/25 and D 160 at t 20
+#: linear S 25/51/100 at p 6.4 and p 1.9/6.4/7.6 at S 100; ODC the smooth upright cone's long cuts (ODC_SMOOTH_SIMS:
+#: straight, nu < 1 at 22.5/67.5 rev/s, nu > 1 at 22.5/45/67.5 rev/s, whole cycles in the window); rotary r 250/1000/3000; indentation concrete D 150 at t 15/20/25 and D 160 at t 20
 TREND_SUBSETS: dict[str, tuple[str, ...]] = {
     "linear_ccs": ("lin_red_s25_p6p4", "lin_red_s51_p6p4", "lin_red_s100_p6p4", "lin_red_s100_p1p9", "lin_red_s100_p7p6"),
-    "odc": ("odc_red_s10", "odc_red_s12", "odc_red_s13", "odc_red_s14", "odc_red_s16", "odc_red_s101", "odc_red_s102",
-            "odc_red_s103", *(f"odc_red_s{sim}_x1" for sim in ODC_X1_SIMS)),
+    "odc": tuple(f"odc_red_s{sim}_long_smoothcone" for sim in ODC_SMOOTH_SIMS),
     "rotary": ("rot_red_r250", "rot_red_r1000", "rot_red_r3000"),
     "indentation_asymmetric": ("ind_red_concrete_d150_t15", "ind_red_concrete_d150_t20", "ind_red_concrete_d150_t25",
                                "ind_red_concrete_d160_t20"),
@@ -743,7 +768,8 @@ EXTRA_PLOTS: dict[str, list[tuple[str, list[str], list[str]]]] = {
 TABLE_FIELDS = [
     "n_grains", "n_bonds_initial", "steps", "dt_s", "wall_s", "particle_steps_per_s", "run_completed",
     "force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
-    "force_magnitude_N_mean_steady", "force_magnitude_N_mean_cycles", "cycles_averaged_1", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
+    "force_magnitude_N_mean_steady", "force_magnitude_N_mean_cycles", "force_magnitude_N_mean_cycles_sliding",
+    "cycles_averaged_1", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
     "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
@@ -768,14 +794,41 @@ def _variant_base(case: str, known: "set[str]", where: Path) -> str:
     return max(bases, key=len)
 
 
-def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants: bool = False) -> "Any":
+def _diff_keys(a: Any, b: Any, path: str = "") -> list[str]:
+    """Dotted paths where two nested dicts differ."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out: list[str] = []
+        for k in sorted(set(a) | set(b)):
+            out += _diff_keys(a.get(k), b.get(k), f"{path}.{k}" if path else str(k))
+        return out
+    return [] if a == b else [path or "(top)"]
+
+
+def _check_same_case(run_spec: dict[str, Any], case_file: Path, where: Path) -> None:
+    """Raise unless the run's resolved case (its spec.json) is ``case_file`` apart from the name."""
+    from deckgen.spec import load_case, resolved_dict
+
+    mine = {k: v for k, v in run_spec.get("case", {}).items() if k != "name"}
+    theirs = {k: v for k, v in resolved_dict(load_case(case_file)).items() if k != "name"}
+    diff = _diff_keys(mine, theirs)
+    if diff:
+        raise ValueError(f"{where}: the run's case differs from {case_file} in {', '.join(diff[:8])}"
+                         + (" ..." if len(diff) > 8 else "") + " (fix: report it as a variant, or run the family case)")
+
+
+def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants: bool = False,
+                 same_as: dict[str, str] | None = None) -> "Any":
     """One row per run of a family: its factors (index.csv), grains, wall time and force/damage metrics.
 
     ``variants``: the runs are diagnostic variants of family cases (e.g. ``odc_red_s12_nospin_bottom``, a copy of
     ``odc_red_s12`` with other kinematics): each row takes the factors of its family case, whose name stays in
     ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case``, the kinematics
     tokens of :data:`VARIANT_TOKENS` and the cutter's surface and friction (:data:`VARIANT_CUTTER`) from its
-    spec.json."""
+    spec.json.
+
+    ``same_as``: run case name -> family case name, for runs of a copy of a family case under another name (e.g. a
+    diagnostic that the generator later took over). Each is checked: the run's resolved case in spec.json must be the
+    family case file's resolved case apart from the name; the row is then the family case's."""
     import json
 
     import pandas as pd
@@ -784,6 +837,8 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
+    if variants:  # a variant's own kinematics tokens and cutter columns win over its family case's factors
+        idx_factors = idx.drop(columns=[c for c in (*VARIANT_TOKENS, *(v[0] for v in VARIANT_CUTTER)) if c in idx.columns])
     rows = []
     for d in map(Path, parsed_dirs):
         summary = d / "summary.json"
@@ -797,7 +852,17 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
         spec = json.loads(spec_json.read_text()) if spec_json else {}
         derived = spec.get("derived", {})
         row["n_shell"] = derived.get("n_shell", float("nan"))
-        if variants:
+        if same_as and s["case"] in same_as:
+            target = same_as[s["case"]]
+            if target not in known:
+                raise ValueError(f"{index_csv}: no case {target!r} for the run {s['case']} (fix: a case of the index)")
+            if not spec:
+                raise ValueError(f"{d}: no spec.json beside the parsed folder, so {s['case']} cannot be checked "
+                                 f"against {target} (fix: keep the run folder)")
+            rel = idx.loc[idx["case"] == target, "file"].iloc[0]
+            _check_same_case(spec, Path(index_csv).parent / rel, summary)
+            s = {**s, "case": target}
+        elif variants:
             kin = spec.get("case", {}).get("kinematics", {})
             row["variant_case"] = s["case"]
             row.update({k: kin.get(k, Kinematics.model_fields[k].default) for k in VARIANT_TOKENS})
@@ -821,7 +886,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
     if variants and runs["case"].duplicated().any():
         dup = sorted(runs.loc[runs["case"].duplicated(keep=False), "variant_case"])
         raise ValueError(f"{', '.join(dup)}: variants of one family case in one report (fix: one variant per report)")
-    return _with_index_factors(idx, runs)
+    return _with_index_factors(idx_factors if variants else idx, runs)
 
 
 def _with_index_factors(idx: "Any", runs: "Any") -> "Any":
@@ -894,13 +959,13 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1,
               "seed 003 Table 5.1, e/R 0.4, 0.5 m/s: 636 N at 22.5 rev/s -> 442.3 N at 67.5 rev/s (the thesis "
-              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and not case.str.endswith('_long') and speedup_1 != 1"),
+              "states -38 %)", x_range=(22.5, 67.5), only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and not case.str.endswith('_long') and not case.str.endswith('_smoothcone') and speedup_1 != 1"),
         Trend("f_falls_with_freq_nu_lt_1_half_cycle", "the same, only runs whose steady window holds at least half an "
               "oscillation cycle (a mean over a fraction of a cycle depends on the phase)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
               only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long') "
-                   "and speedup_1 != 1"),
+                   "and not case.str.endswith('_smoothcone') and speedup_1 != 1"),
         Trend("f_flat_with_freq_nu_gt_1", "no fall of the mean force with frequency when nu > 1 (no backward motion; "
               "supplementary runs 101-103, at least half a cycle in the window)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), 0, 0.0,
@@ -908,15 +973,15 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "at 22.5 rev/s, nu 3.5, 1.8) the mean force is 735 and 754 N against 712 N without oscillation (taken as "
               "no change)", x_range=(45, 67.5),
               only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and not case.str.endswith('_long') "
-                   "and speedup_1 != 1"),
+                   "and not case.str.endswith('_smoothcone') and speedup_1 != 1"),
         Trend("f_falls_with_freq_nu_lt_1_x1", "the half-cycle trend above on the x1 cuts (the seed's speed and frequency)",
               "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), -1,
               442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)", x_range=(22.5, 67.5),
-              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1"),
+              only="velocity_ratio_nu_1 < 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1 and not case.str.endswith('_smoothcone')"),
         Trend("f_flat_with_freq_nu_gt_1_x1", "no fall with frequency when nu > 1, on the x1 cuts (the seed's speed and "
               "frequency)", "force_magnitude_N_mean_steady", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"),
               0, 0.0, "seed 003 sec. 5.4.3 (as above)", x_range=(45, 67.5),
-              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1"),
+              only="velocity_ratio_nu_1 > 1 and frequency_hz > 0 and cycles_in_window_1 >= 0.5 and speedup_1 == 1 and not case.str.endswith('_smoothcone')"),
         Trend("f_rises_with_nu_long", "at one frequency, the mean force rises from nu < 1 (backward motion) to nu > 1 "
               "(long cuts; mean over the whole cycle in the window)", "force_magnitude_N_mean_cycles", "velocity_ratio_nu_1",
               (), +1,
@@ -924,6 +989,21 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "seed 003 sec. 5.4.2-5.4.3, 22.5 rev/s, 0.5 m/s: 636 N at e/R 0.4 (nu 0.88) -> 754 and 735 N at e/R 0.2 and "
               "0.1 (nu 1.77, 3.54); 712 N without oscillation", x_range=(0.884, 3.537), log_x=True,
               only="case.str.endswith('_long') and frequency_hz > 0"),
+        # the smooth upright cone's long cuts (ODC_SMOOTH_SIMS): whole-cycle means slid over the steady window
+        # (results.py: at 90 Hz the window holds 1.39 cycles), depth at the orbit's bottom
+        Trend("f_falls_with_freq_nu_lt_1_smooth", "mean force falls with the oscillation frequency when nu < 1 (smooth "
+              "upright cone, long cuts, mean over every whole-cycle window of the steady window)", "force_magnitude_N_mean_cycles_sliding", "frequency_full_hz",
+              ("eccentricity_ratio_1", "speed_full_m_s"), -1, 442.3 / 636.0 - 1, "seed 003 Table 5.1 (as above)",
+              x_range=(22.5, 67.5), only="case.str.endswith('_smoothcone') and velocity_ratio_nu_1 < 1"),
+        Trend("f_flat_with_freq_nu_gt_1_smooth", "no fall of the mean force with frequency when nu > 1 (smooth upright "
+              "cone, long cuts, e/R 0.1 at 22.5/45/67.5 rev/s: nu 3.54/1.77/1.18; mean over every whole-cycle window of the steady window)",
+              "force_magnitude_N_mean_cycles_sliding", "frequency_full_hz", ("eccentricity_ratio_1", "speed_full_m_s"), 0, 0.0,
+              "seed 003 sec. 5.4.3 (as above); the seed ran nu > 1 at 22.5 rev/s only", x_range=(22.5, 67.5),
+              only="case.str.endswith('_smoothcone') and velocity_ratio_nu_1 > 1 and frequency_hz > 0"),
+        Trend("f_rises_with_nu_smooth", "at 22.5 rev/s (x4: 90 Hz) the mean force rises from nu < 1 to nu > 1 (smooth "
+              "upright cone, long cuts, mean over every whole-cycle window of the steady window)", "force_magnitude_N_mean_cycles_sliding", "velocity_ratio_nu_1",
+              (), +1, 735.0 / 636.0 - 1, "seed 003 sec. 5.4.2-5.4.3 (as above)", x_range=(0.884, 3.537), log_x=True,
+              only="case.str.endswith('_smoothcone') and frequency_full_hz == 22.5"),
     ),
 }
 
@@ -1056,8 +1136,8 @@ def family_plots(family: str, table: "Any", out: str | Path) -> list[Path]:
 
 
 def report(family: str, index_csv: str | Path, parsed_dirs: list[str | Path], out: str | Path,
-           variants: bool = False) -> Path:
-    return report_table(family, family_table(index_csv, parsed_dirs, variants=variants), out)
+           variants: bool = False, same_as: dict[str, str] | None = None) -> Path:
+    return report_table(family, family_table(index_csv, parsed_dirs, variants=variants, same_as=same_as), out)
 
 
 def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None) -> "Any":
@@ -1110,6 +1190,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--variants", action="store_true", help="report: the runs are diagnostic variants of family cases "
                    "('<family case>_<suffix>', one per family case): rows take their family case's factors and name, with "
                    "variant_case, spin, shaft_sense and penetration_at beside")
+    p.add_argument("--same-as", action="append", default=[], metavar="RUN=CASE",
+                   help="report: the run named RUN is a copy of the family case CASE under another name (checked: the "
+                   "run's spec.json must equal the case file apart from the name); repeatable")
     p.add_argument("parsed", nargs="*", help="report: parsed run folders (with summary.json); combine: family_table.csv files")
     args = p.parse_intermixed_args(argv)  # run folders may follow the options, as in rules/families.smk
     if args.command == "combine":
@@ -1128,8 +1211,12 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "report":
         if not (args.family and args.index and args.out):
             p.error("report needs --family, --index and --out")
+        bad = [a for a in args.same_as if a.count("=") != 1 or not all(a.split("="))]
+        if bad:
+            p.error(f"report: --same-as wants RUN=CASE, got {', '.join(bad)}")
         try:
-            path = report(args.family, args.index, args.parsed, args.out, variants=args.variants)
+            path = report(args.family, args.index, args.parsed, args.out, variants=args.variants,
+                          same_as=dict(a.split("=") for a in args.same_as))
         except ValueError as exc:
             p.error(f"report: {exc}")
         print(f"wrote {path} ({len(args.parsed)} runs) and plots")

@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 126 + 2 * len(NAMES)  # 126 case files + index.csv and README.md per family
+    assert len(files) == 128 + 2 * len(NAMES)  # 128 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -52,7 +52,7 @@ def test_case_counts_per_family():
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
         ("rotary", "full"): 4, ("rotary", "reduced"): 4,
-        ("odc", "full"): 10, ("odc", "reduced"): 28,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 smooth long cuts
+        ("odc", "full"): 10, ("odc", "reduced"): 30,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 + 2 smooth long cuts
     }
 
 
@@ -67,7 +67,7 @@ def test_every_family_case_validates_and_its_path_fits_the_block(family, scale):
         cutter_path(case, case.cutter.diameter_mm * MM / 2)
         est = fam.estimate(case.model_dump())
         assert est["steps_est"] < case.run.max_steps, path
-        if scale == "reduced" and path.stem.endswith(("_long", "_long_smoothcone")):  # the long ODC cuts: 3.7x the travel
+        if scale == "reduced" and path.stem.endswith(("_long", "_long_smoothcone")) or "_long_smoothcone_k" in path.stem:  # the long ODC cuts: 3.7x the travel
             assert est["n_grains_est"] <= 4000 and est["steps_est"] <= 600_000, (path, est)
             assert est["particle_steps_est"] <= 2e9, (path, est)  # <= ~17 min at 2 M particle-steps/s
         elif scale == "reduced" and path.stem.endswith("_x1"):  # the ODC cuts at the seed's speed: 4x the steps
@@ -189,7 +189,7 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):
         k = 1 if c.name.endswith("_x1") else 4  # the x1 cuts keep the seed's speed and frequency
-        name = c.name.removesuffix("_x1").removesuffix("_smoothcone").removesuffix("_long")
+        name = re.sub(r"_k\d+$", "", c.name).removesuffix("_x1").removesuffix("_smoothcone").removesuffix("_long")
         if name in sup:  # no full-scale twin: the stated seed-unit values x4
             e, f, v = sup[name]
             assert (c.kinematics.speed_m_s, c.kinematics.frequency_hz) == (pytest.approx(k * v), pytest.approx(k * f))
@@ -473,7 +473,7 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
     n = sum(len(v) for v in fam.TREND_SUBSETS.values())
-    assert n == 18
+    assert n == 20
     for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
         assert f"{rule} {count}" in text, (rule, count, text[-1500:])
     for names in fam.TREND_SUBSETS.values():
@@ -518,7 +518,14 @@ def test_odc_smooth_long_cuts_are_the_long_cuts_on_an_upright_smooth_cone():
 
     cases = {c.name: c for c in fam.odc()}
     smooth = [cases[f"odc_red_s{sim}_long_smoothcone"] for sim in fam.ODC_SMOOTH_SIMS]
-    assert set(fam.TREND_SUBSETS["odc"]) == {c.name for c in smooth}
+    reps = [cases[f"odc_red_s{sim}_long_smoothcone_k202"] for sim in fam.ODC_SMOOTH_REPLICATE_SIMS]
+    assert set(fam.TREND_SUBSETS["odc"]) == {c.name for c in smooth + reps}
+    for r in reps:  # only the name and the packing differ
+        first = cases[r.name.removesuffix("_k202")]
+        assert r.data["packing"] == {**first.data["packing"], "seed": 202} and r.factors["packing_seed"] == 202
+        assert {k: v for k, v in r.data.items() if k not in ("name", "packing")} == \
+            {k: v for k, v in first.data.items() if k not in ("name", "packing")}
+        assert first.factors["packing_seed"] == 12345
     for c in smooth:
         d, kin = c.data, c.data["kinematics"]
         assert d["cutter"]["surface"] == "smooth" and d["cutter"]["clearance_angle_deg"] == 0
@@ -537,16 +544,20 @@ def test_odc_smooth_long_cuts_are_the_long_cuts_on_an_upright_smooth_cone():
     for name, f, nu, ecc, force in [("odc_red_s11_long_smoothcone", 90, 0.884, 0.4, 10.0), ("odc_red_s14_long_smoothcone", 270, 0.295, 0.4, 7.0),
                                      ("odc_red_s16_long_smoothcone", 90, 3.537, 0.1, 25.0), ("odc_red_s101_long_smoothcone", 180, 1.768, 0.1, 24.0),
                                      ("odc_red_s103_long_smoothcone", 270, 1.179, 0.1, 25.5), ("odc_red_s11_long", 90, 0.884, 0.4, 99.0),
-                                     ("odc_red_s12", 180, 0.442, 0.4, 30.0), ("odc_red_s13", 240, 0.332, 0.4, 20.0)]:
+                                     ("odc_red_s12", 180, 0.442, 0.4, 30.0), ("odc_red_s13", 240, 0.332, 0.4, 20.0),
+                                     ("odc_red_s11_long_smoothcone_k202", 90, 0.884, 0.4, 12.0),
+                                     ("odc_red_s14_long_smoothcone_k202", 270, 0.295, 0.4, 8.4)]:
         rows.append({"case": name, "frequency_hz": f, "frequency_full_hz": f / 4, "velocity_ratio_nu_1": nu, "speedup_1": 4,
                      "eccentricity_ratio_1": ecc, "speed_full_m_s": 0.5, "cycles_in_window_1": 0.7 * 44e-3 * f / 2,
                      "force_magnitude_N_mean_steady": force, "force_magnitude_N_mean_cycles": force,
                      "force_magnitude_N_mean_cycles_sliding": force})
     t = fam.trend_table("odc", pd.DataFrame(rows)).set_index("trend")
     falls, flat, up = (t.loc[k] for k in ("f_falls_with_freq_nu_lt_1_smooth", "f_flat_with_freq_nu_gt_1_smooth", "f_rises_with_nu_smooth"))
-    assert falls["runs"] == 2 and falls["change_1"] == pytest.approx(-0.3, abs=1e-9) and bool(falls["sign_as_seed"])
+    # two packings at each frequency: 10/12 N -> 7/8.4 N, the line through the means 11 -> 7.7 N: -30 %
+    assert falls["runs"] == 4 and falls["change_1"] == pytest.approx(7.7 / 11.0 - 1, abs=1e-9) and bool(falls["sign_as_seed"])
+    assert falls["p_value"] < 0.2
     assert flat["runs"] == 3 and flat["p_value"] > 0.05 and bool(flat["sign_as_seed"])
-    assert up["runs"] == 2 and up["slope"] > 0 and bool(up["sign_as_seed"])
+    assert up["runs"] == 3 and up["slope"] > 0 and bool(up["sign_as_seed"])
     assert t.loc["f_falls_with_freq_nu_lt_1", "runs"] == 2  # the 12 mm cuts only: neither smooth nor long cuts
 
 

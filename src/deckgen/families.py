@@ -235,6 +235,17 @@ def _cutting(name: str, rock: str, packing: dict[str, Any], bonds: dict[str, Any
     return d
 
 
+def _replicates(c: CaseDef, seeds: tuple[int, ...]) -> list[CaseDef]:
+    """Copies of case ``c`` named ``<name>_k<seed>`` on other packing seeds (only the packing differs)."""
+    out = []
+    for seed in seeds:
+        rep = f"{c.name}_k{seed}"
+        data = {**c.data, "name": rep, "packing": {**c.data["packing"], "seed": seed}}
+        header = [c.header[0], f"Replicate of {c.name} on packing seed {seed} (only the packing differs).", *c.header[1:]]
+        out.append(CaseDef(c.family, c.scale, rep, header, data, {**c.factors, "packing_seed": seed}))
+    return out
+
+
 def _max_steps(data: dict[str, Any]) -> int:
     """run.max_steps for full-scale cases: twice the estimate, rounded up to a million."""
     s = estimate(data)["steps_est"]
@@ -422,12 +433,7 @@ def linear_ccs() -> list[CaseDef]:
                        "ridge_grains_1": _r(ridge / (packing["radius_min_mm"] + packing["radius_max_mm"]), 2)}
             out.append(CaseDef(fam, scale, name, header, data, {**factors, "packing_seed": DEFAULT_PACKING_SEED}))
             if scale == "reduced" and S_full in LINEAR_REPLICATE_SPACINGS:
-                for seed in LINEAR_REPLICATE_SEEDS:
-                    rep = f"{name}_k{seed}"
-                    rdata = {**data, "name": rep, "packing": {**packing, "seed": seed}}
-                    rheader = [header[0], f"Replicate of {name} on packing seed {seed} (only the packing differs).",
-                               *header[1:]]
-                    out.append(CaseDef(fam, scale, rep, rheader, rdata, {**factors, "packing_seed": seed}))
+                out += _replicates(out[-1], LINEAR_REPLICATE_SEEDS)
     return out
 
 
@@ -548,9 +554,9 @@ def odc() -> list[CaseDef]:
     rock = "savonniere_limestone"
     out: list[CaseDef] = []
     for scale in SCALES:
-        runs = [(row, False) for row in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ())]
-        runs = [(row, long, 1.0 if scale == "full" else ODC_SPEEDUP) for row, long in runs]
-        runs = [(row, long, k, False) for row, long, k in runs]
+        # (Table 5.1 row, long cut, speed-up, smooth cone)
+        runs = [(row, False, 1.0 if scale == "full" else ODC_SPEEDUP, False)
+                for row in SEED003_SIMS + (ODC_SUPPLEMENTARY if scale == "reduced" else ())]
         if scale == "reduced":
             runs += [(row, True, ODC_SPEEDUP, False) for row in SEED003_SIMS if row[0] in ODC_LONG_SIMS]
             runs += [(row, False, 1.0, False) for row in SEED003_SIMS + ODC_SUPPLEMENTARY if row[0] in ODC_X1_SIMS]
@@ -652,12 +658,7 @@ def odc() -> list[CaseDef]:
                 "penetration_at": kin.get("penetration_at", "start")}
             out.append(CaseDef(fam, scale, name, header, data, {**factors, "packing_seed": DEFAULT_PACKING_SEED}))
             if smooth and sim in ODC_SMOOTH_REPLICATE_SIMS:
-                for seed in ODC_SMOOTH_REPLICATE_SEEDS:
-                    rep = f"{name}_k{seed}"
-                    rdata = {**data, "name": rep, "packing": {**packing, "seed": seed}}
-                    rheader = [header[0], f"Replicate of {name} on packing seed {seed} (only the packing differs).",
-                               *header[1:]]
-                    out.append(CaseDef(fam, scale, rep, rheader, rdata, {**factors, "packing_seed": seed}))
+                out += _replicates(out[-1], ODC_SMOOTH_REPLICATE_SEEDS)
     return out
 
 

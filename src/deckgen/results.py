@@ -721,14 +721,11 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
         t_s = t[rows]
         span = n_cycles * 2 * math.pi / omega
         ends = np.searchsorted(t_s, t_s + span * (1 - 1e-9), side="left")  # first row at or after start + span
-        ok = ends < len(rows)  # the window closes inside the steady rows
+        starts = np.flatnonzero(ends < len(rows))  # windows that close inside the steady rows
+        ends = ends[starts]
         for q in CUTTING_QUANTITIES:
-            if not ok.any():
-                sliding[q] = _nan()
-                continue
             c = np.concatenate([[0.0], np.cumsum(ts[q].to_numpy()[rows])])
-            starts = np.flatnonzero(ok)
-            sliding[q] = float(np.mean((c[ends[ok]] - c[starts]) / (ends[ok] - starts)))
+            sliding[q] = float(np.mean((c[ends] - c[starts]) / (ends - starts))) if len(starts) else _nan()
     for q in CUTTING_QUANTITIES:
         out[f"{q}_mean_cycles_sliding"] = (sliding.get(q, _nan()) if ecc > 0 and omega > 0
                                            else out[f"{q}_mean_steady"])

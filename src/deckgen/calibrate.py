@@ -327,6 +327,8 @@ class MicroParams:
     twisting_strength_factor: float = 1.0  # critical twisting torque / parallel-bond value (bonds.*)
     strength_weibull_modulus: float = 0.0  # bond strength scatter (bonds.strength_weibull_modulus; 0 = none)
     shrink_before_bonding: float = 0.02  # radius shrink before bonding (bonds.*): the initial gap of every contact
+    flat_joint: int = 0  # 1: bonds.model flat_joint (deckgen's plugin bond), 0: bpm_rotational
+    joint_friction: float = 0.5  # bonds.joint_friction (flat joint only)
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -350,6 +352,8 @@ class MicroParams:
         for name, default in self.optional_defaults().items():
             if vals[name] == default:
                 del vals[name]
+        if vals["flat_joint"] == 0:  # bpm_rotational points keep the keys they had before the flat joint
+            del vals["flat_joint"], vals["joint_friction"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
@@ -364,6 +368,8 @@ class MicroParams:
         for name, default in self.optional_defaults().items():
             if getattr(self, name) != default:
                 bonds[name] = getattr(self, name)
+        if self.flat_joint:
+            bonds.update(model="flat_joint", joint_friction=self.joint_friction)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

@@ -150,11 +150,24 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("c4 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 4}),
     ("c4 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 4}),
 ]
+#: The flat joint (bonds.model flat_joint, deckgen's plugin bond: tension and Mohr-Coulomb shear checked apart,
+#: a broken bond stays a frictional face that resists rocking) at the high-strain base point; the first row is
+#: the bpm/rotational base itself, measured beside it.
+FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
+    ("bpm/rotational base (sigma_c/E_b 3e-3, g 0.4, E_c/E_b 4, tau/sigma 1)", {}),
+    ("flat joint, mu 0.5", {"flat_joint": 1}),
+    ("flat joint, mu 1.0", {"flat_joint": 1, "joint_friction": 1.0}),
+    ("flat joint, mu 0.5, c/sigma 2", {"flat_joint": 1, "shear_strength_MPa": 120.0}),
+    ("flat joint, mu 0.5, c/sigma 0.5", {"flat_joint": 1, "shear_strength_MPa": 30.0}),
+    ("flat joint, mu 0.5, g 0.05", {"flat_joint": 1, "gap_tolerance": 0.05}),
+    ("flat joint, mu 0.5, E_c/E_b 1", {"flat_joint": 1, "contact_modulus_ratio": 1.0}),
+]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
     "default": (MicroParams(youngs_modulus_GPa=40.0, tensile_strength_MPa=30.0, shear_strength_MPa=60.0),
                 RATIO_VARIANTS, "ratio"),
     "high-strain": (HIGH_STRAIN_BASE, HIGH_STRAIN_VARIANTS, "ratio_high_strain"),
+    "flat-joint": (HIGH_STRAIN_BASE, FLAT_JOINT_VARIANTS, "ratio_flat_joint"),
 }
 
 

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from deckgen import __version__
+from deckgen import __version__, plugins
 from deckgen.bonds import (
     COEFF_NAMES,
     binning_error,
@@ -37,6 +37,8 @@ from deckgen.spec import GPA, MM, MPA, BrazilianDisc, Case, CuttingBlock, SpecEr
 
 DECK = "in.deck"
 DATA = "specimen.data"
+#: Broken bonds of a flat-joint deck, one line each (step id1 id2 mode x y z; mode 1 tension, 2 shear).
+FLAT_JOINT_BROKEN = "broken_joints.txt"
 SHELL_DENSITY = 7850.0 * 1000.0  # cutter shell spheres: heavy, so contact m_eff ~ grain mass
 
 
@@ -491,8 +493,17 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         "version": __version__, "case_name": case.name, "test": case.test, "deck_name": DECK,
         "data_file": DATA, "integrate_group": "rock", "pair_coeffs": pair_coeffs,
         "bond_coeffs": table.coeff_rows(), "bond_state_every": case.outputs.bond_state_every,
-        "jaws": False,
+        "jaws": False, "flat_joint": None,
     }
+    if b.model == "flat_joint":  # deckgen's own bond style, a plugin copied into the run folder
+        try:
+            plugin = plugins.install(out, "flatjoint")
+        except plugins.PluginError as exc:
+            raise SpecError(f"case {case.name}: bonds.model: flat_joint: {exc}") from None
+        ctx["flat_joint"] = {
+            "library": plugin, "broken_file": FLAT_JOINT_BROKEN,
+            "coeffs": [b.youngs_modulus_GPa * GPA, b.stiffness_ratio, b.radius_multiplier,
+                       b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio]}
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
         "omega_translational_rad_s": dt_info["omega_translational_rad_s"],

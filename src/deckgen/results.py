@@ -66,7 +66,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from deckgen.deck import FLAT_JOINT_BROKEN
 from deckgen.parse import ParseError, TruncatedError, check_log, iter_frames, read_series
+from deckgen.parse.common import open_text
 
 __all__ = [
     "CUTTING_SUMMARY_COLUMNS",
@@ -409,6 +411,35 @@ def _read_broken(path: Path, state: _RunState) -> pd.DataFrame:
                              "y_m": pd.Series(dtype="float64"), "z_m": pd.Series(dtype="float64")})
     df = pd.concat(parts, ignore_index=True)
     return df.sort_values(["step", "id1", "id2"], kind="stable").reset_index(drop=True)
+
+
+FLAT_JOINT_MODES = {1: "tension", 2: "shear"}
+
+
+def _read_broken_joints(path: Path) -> pd.DataFrame:
+    """The flat-joint plugin's broken-bond file (``step id1 id2 mode x y z``; mode 1 tension, 2 shear),
+    read line by line; a bad line fails with the file and line. The failure mode is the bond's own."""
+    cols: dict[str, list] = {k: [] for k in ("id1", "id2", "step", "x_m", "y_m", "z_m", "mode")}
+    with open_text(path) as fh:
+        for lineno, line in enumerate(fh, 1):
+            t = line.split()
+            if not t or t[0].startswith("#"):
+                continue
+            if len(t) != 7:
+                raise ParseError(path, lineno, f"expected 7 fields (step id1 id2 mode x y z), got {len(t)}")
+            try:
+                step, i1, i2, mode = int(t[0]), int(t[1]), int(t[2]), int(t[3])
+                xyz = [float(v) for v in t[4:]]
+            except ValueError:
+                raise ParseError(path, lineno, f"not numbers: {line.strip()[:80]!r}") from None
+            if mode not in FLAT_JOINT_MODES or not all(math.isfinite(v) for v in xyz):
+                raise ParseError(path, lineno, f"mode must be 1 or 2 and coordinates finite: {line.strip()[:80]!r}")
+            lo, hi = min(i1, i2), max(i1, i2)
+            for k, v in zip(cols, (lo, hi, step, *xyz, FLAT_JOINT_MODES[mode])):
+                cols[k].append(v)
+    out = pd.DataFrame({k: pd.Series(v, dtype="int64" if k in ("id1", "id2", "step") else
+                                     (object if k == "mode" else "float64")) for k, v in cols.items()})
+    return out.sort_values("step", kind="stable").reset_index(drop=True)
 
 
 def _classify(broken: pd.DataFrame, bonds_path: Path, coeffs: dict[str, list[float]],
@@ -798,9 +829,14 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
         ts = _cutting_timeseries(raw, series_path, n0, spec)
 
     broken_path = run_dir / "broken.dump.gz"
-    have_broken = broken_path.is_file()
-    if have_broken:
+    joints_path = run_dir / FLAT_JOINT_BROKEN
+    have_broken = broken_path.is_file() or joints_path.is_file()
+    joint_modes = None
+    if broken_path.is_file():
         broken = _read_broken(broken_path, state)
+    elif joints_path.is_file():  # deckgen's flat-joint bond writes its own list, with the failure mode
+        broken = _read_broken_joints(joints_path)
+        joint_modes = broken.pop("mode").to_numpy(dtype=object)
     else:
         state.notes.append("no broken.dump.gz: no broken-bond list; bonds_broken from the series")
         broken = pd.DataFrame(  # empty, typed
@@ -808,7 +844,11 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
              "x_m": pd.Series(dtype="float64"), "y_m": pd.Series(dtype="float64"), "z_m": pd.Series(dtype="float64")})
     broken.insert(3, "time_s", broken["step"].to_numpy(dtype=float) * dt)
     bonds_path = run_dir / "bonds.dump.gz"
-    if bonds_path.is_file():
+    if joint_modes is not None:
+        broken = _unclassified(broken)
+        broken["mode"] = joint_modes
+        mode_source = FLAT_JOINT_BROKEN
+    elif bonds_path.is_file():
         broken = _classify(broken, bonds_path, derived["bond_coefficients"], state)
         mode_source = "bonds.dump.gz"
     else:

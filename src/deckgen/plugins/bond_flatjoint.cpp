@@ -31,7 +31,9 @@
    compute nbond/atom counts intact bonds only.
 
    Syntax:  bond_style deckgen/flatjoint FILE          (FILE: broken bonds, one line each, appended)
-            bond_coeff T E_b kappa lambda sigma_c c mu zeta      (SI: Pa, -, -, Pa, Pa, -, -)
+            bond_coeff T E_b kappa lambda sigma_c c mu zeta [slit]   (SI: Pa, -, -, Pa, Pa, -, -; slit 0/1)
+   A bond type with slit 1 holds faces that are broken from the start: closed, cohesionless contacts with the
+   broken face's law (the slit elements of Potyondy's flat joint); they are neither counted nor listed as breaks.
    Serial only (one MPI rank): bond states live in this object, keyed by atom tags.
 */
 
@@ -145,16 +147,18 @@ class BondFlatJoint : public Bond {
 
   void coeff(int narg, char **arg) override
   {
-    if (narg != 8) error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta");
+    if (narg != 8 && narg != 9)
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta [slit]");
     if (!allocated) allocate();
     int ilo, ihi;
     utils::bounds(FLERR, arg[0], 1, atom->nbondtypes, ilo, ihi, error);
-    double v[7];
-    for (int k = 0; k < 7; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
+    double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < narg - 1; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
+    if (v[7] != 0.0 && v[7] != 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 or 1");
     if (v[0] <= 0.0 || v[1] <= 0.0 || v[2] <= 0.0 || v[3] <= 0.0 || v[4] < 0.0 || v[5] < 0.0 || v[6] < 0.0)
       error->all(FLERR, "bond_coeff for deckgen/flatjoint: E_b, kappa, lambda, sigma_c > 0; c, mu, zeta >= 0");
     for (int t = ilo; t <= ihi; t++) {
-      for (int k = 0; k < 7; k++) coeffs[t][k] = v[k];
+      for (int k = 0; k < 8; k++) coeffs[t][k] = v[k];
       setflag[t] = 1;
     }
   }
@@ -212,6 +216,14 @@ class BondFlatJoint : public Bond {
       if (i >= nlocal || j >= nlocal) error->one(FLERR, "bond_style deckgen/flatjoint: bond to a ghost atom");
       if (atom->tag[i] > atom->tag[j]) std::swap(i, j);
       const size_t id = joint_id(i, j, type);
+      if (joints[id].broken) {    // a slit face, met for the first time: it joins the broken faces silently
+        bondlist[n][2] = 0;
+        set_bond_type_zero(i, atom->tag[j]);
+        set_bond_type_zero(j, atom->tag[i]);
+        broken_ids.push_back(id);
+        interact(joints[id], i, j);
+        continue;
+      }
       if (interact(joints[id], i, j)) {
         bondlist[n][2] = 0;
         set_bond_type_zero(i, atom->tag[j]);
@@ -223,7 +235,7 @@ class BondFlatJoint : public Bond {
   }
 
  private:
-  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta
+  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta slit
   std::string filename;
   FILE *out = nullptr;
   std::vector<Joint> joints;
@@ -238,7 +250,7 @@ class BondFlatJoint : public Bond {
     allocated = 1;
     const int nt = atom->nbondtypes;
     memory->create(setflag, nt + 1, "bond:setflag");
-    memory->create(coeffs, nt + 1, 7, "bond:coeffs");
+    memory->create(coeffs, nt + 1, 8, "bond:coeffs");
     for (int t = 0; t <= nt; t++) setflag[t] = 0;
   }
 
@@ -258,7 +270,7 @@ class BondFlatJoint : public Bond {
     b.tag_i = atom->tag[i];
     b.tag_j = atom->tag[j];
     b.type = type;
-    b.broken = false;
+    b.broken = coeffs[type][7] > 0.0;    // slit: broken from the start
     double d[3] = {atom->x[j][0] - atom->x[i][0], atom->x[j][1] - atom->x[i][1], atom->x[j][2] - atom->x[i][2]};
     b.r0 = norm3(d);
     const double *c = coeffs[type];

@@ -34,7 +34,7 @@ needs_engine = pytest.mark.skipif(not (engine_available() and have_compiler),
 
 # two grains of radius 1 mm, density 2500, touching; the bond law's numbers
 R, RHO = 1e-3, 2500.0
-E_B, KAPPA, LAM, SIGMA_C, COH, MU = 1e9, 2.5, 1.0, 1e6, 2e6, 0.5
+E_B, KAPPA, LAM, SIGMA_C, COH, MU, BETA = 1e9, 2.5, 1.0, 1e6, 2e6, 0.5, 1.0
 AREA = math.pi * (LAM * R) ** 2
 K_N = E_B / (2 * R) * AREA  # N/m
 DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
@@ -59,7 +59,7 @@ set type 1 density {RHO:.10g}
 pair_style granular
 pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
 bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
-bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0
+bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {BETA:.10g}
 create_bonds single/bond 1 1 2
 group g2 id 2
 timestep {DT:.10g}
@@ -153,7 +153,7 @@ def test_deck_loads_the_plugin_from_the_run_folder_with_si_coefficients(tmp_path
     b = case.bonds
     assert [float(v) for v in line.split()[2:]] == pytest.approx(
         [b.youngs_modulus_GPa * 1e9, b.stiffness_ratio, b.radius_multiplier, b.tensile_strength_MPa * 1e6,
-         b.shear_strength_MPa * 1e6, 0.7, b.damping_ratio])
+         b.shear_strength_MPa * 1e6, 0.7, b.damping_ratio, 1.0])
     assert "bpm/rotational" not in deck and "broken.dump.gz" not in deck
 
 

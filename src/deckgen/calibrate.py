@@ -329,6 +329,7 @@ class MicroParams:
     shrink_before_bonding: float = 0.02  # radius shrink before bonding (bonds.*): the initial gap of every contact
     flat_joint: int = 0  # 1: bonds.model flat_joint (deckgen's plugin bond), 0: bpm_rotational
     joint_friction: float = 0.5  # bonds.joint_friction (flat joint only)
+    moment_contribution: float = 1.0  # bonds.moment_contribution (flat joint only)
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -353,7 +354,9 @@ class MicroParams:
             if vals[name] == default:
                 del vals[name]
         if vals["flat_joint"] == 0:  # bpm_rotational points keep the keys they had before the flat joint
-            del vals["flat_joint"], vals["joint_friction"]
+            del vals["flat_joint"], vals["joint_friction"], vals["moment_contribution"]
+        elif vals["moment_contribution"] == 1.0:  # flat-joint points recorded before beta existed
+            del vals["moment_contribution"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
@@ -370,6 +373,8 @@ class MicroParams:
                 bonds[name] = getattr(self, name)
         if self.flat_joint:
             bonds.update(model="flat_joint", joint_friction=self.joint_friction)
+            if self.moment_contribution != 1.0:
+                bonds["moment_contribution"] = self.moment_contribution
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

@@ -170,6 +170,9 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("flat joint, mu 0.5, slits 0.25", {"flat_joint": 1, "unbonded_fraction": 0.25}),
     ("flat joint, mu 0.5, slits 0.5", {"flat_joint": 1, "unbonded_fraction": 0.5}),
     ("flat joint, mu 0.5, slits 0.75", {"flat_joint": 1, "unbonded_fraction": 0.75}),
+    # UCS scaled with sigma_c (tension breaks, bending included): PFC's moment-contribution factor beta
+    ("flat joint, mu 0.5, beta 0.5", {"flat_joint": 1, "moment_contribution": 0.5}),
+    ("flat joint, mu 0.5, beta 0", {"flat_joint": 1, "moment_contribution": 0.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

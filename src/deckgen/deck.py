@@ -511,7 +511,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         except plugins.PluginError as exc:
             raise SpecError(f"case {case.name}: bonds.model: flat_joint: {exc}") from None
         coeffs = [b.youngs_modulus_GPa * GPA, b.stiffness_ratio, b.radius_multiplier,
-                  b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio]
+                  b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio,
+                  b.moment_contribution]
         ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
                              "slit_type": table.ntypes + 1 if len(slits) else None}
     derived: dict[str, Any] = {

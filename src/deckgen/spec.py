@@ -168,6 +168,12 @@ class Bonds(_Model):
         "compression, friction and a rocking moment up to |F_n| x bond radius (after Potyondy 2012's flat joint); "
         "pairs left unbonded by unbonded_fraction become slit faces, broken from the start. LAMMPS on one rank only. Written to spec.json only when flat_joint.",
     )
+    moment_contribution: float = Field(
+        1.0, ge=0, le=1, exclude_if=lambda v: v == 1.0, json_schema_extra={"unit": "1"},
+        description="flat_joint only: moment-contribution factor beta of the failure checks, sigma = F_n/A + "
+        "beta |M_b| R_b/I and tau = |F_s|/A + beta |M_t| R_b/J (PFC's parallel bond; 1: bending and twisting load the "
+        "bond's rim fully, 0: only forces break bonds). Written to spec.json only when not 1.",
+    )
     joint_friction: float = Field(
         0.5, ge=0, le=5, exclude_if=lambda v: v == 0.5, json_schema_extra={"unit": "1"},
         description="flat_joint only: friction coefficient of the intact bond's Mohr-Coulomb shear strength and of "
@@ -194,8 +200,11 @@ class Bonds(_Model):
                 if value != plain:
                     raise ValueError(f"{field}: not available with model: flat_joint, whose bonds all share one law "
                                      f"(fix: {field}: {plain:g}, or model: bpm_rotational)")
-        elif self.joint_friction != 0.5:
-            raise ValueError("joint_friction: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
+        else:
+            for field, value, plain in (("joint_friction", self.joint_friction, 0.5),
+                                        ("moment_contribution", self.moment_contribution, 1.0)):
+                if value != plain:
+                    raise ValueError(f"{field}: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
         return self
 
 

@@ -20,8 +20,9 @@
      shear    F_s += -k_s A v_t dt                   (incremental, on j; v_t tangential slip at the face)
      twist    M_t += -k_s J (w_rel . n) dt           (incremental, about n)
      bending  M_b += -k_n I (w_rel - (w_rel.n) n) dt
-   Intact: tensile failure if f_n/A + |M_b| R_b / I >= sigma_c; shear failure if
-   |F_s|/A + |M_t| R_b / J >= c + mu * max(0, -f_n/A).
+   Intact: tensile failure if f_n/A + beta |M_b| R_b / I >= sigma_c; shear failure if
+   |F_s|/A + beta |M_t| R_b / J >= c + mu * max(0, -f_n/A); beta is the moment-contribution factor of
+   PFC's parallel bond (1: the moments load the bond's rim fully; 0: only forces break bonds).
    Broken: no tension (f_n = 0 and all loads reset while the face is open), in compression
    |F_s| <= mu |f_n|, |M_b| <= |f_n| R_b, |M_t| <= mu |f_n| 2 R_b / 3 (uniform pressure on the face).
    Damping: viscous, ratio zeta of the relative motion, on the normal, shear, bending and twisting rates
@@ -31,7 +32,7 @@
    compute nbond/atom counts intact bonds only.
 
    Syntax:  bond_style deckgen/flatjoint FILE          (FILE: broken bonds, one line each, appended)
-            bond_coeff T E_b kappa lambda sigma_c c mu zeta [slit]   (SI: Pa, -, -, Pa, Pa, -, -; slit 0/1)
+            bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit]   (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1)
    A bond type with slit 1 holds faces that are broken from the start: closed, cohesionless contacts with the
    broken face's law (the slit elements of Potyondy's flat joint); they are neither counted nor listed as breaks.
    Serial only (one MPI rank): bond states live in this object, keyed by atom tags.
@@ -147,18 +148,19 @@ class BondFlatJoint : public Bond {
 
   void coeff(int narg, char **arg) override
   {
-    if (narg != 8 && narg != 9)
-      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta [slit]");
+    if (narg != 9 && narg != 10)
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta beta [slit]");
     if (!allocated) allocate();
     int ilo, ihi;
     utils::bounds(FLERR, arg[0], 1, atom->nbondtypes, ilo, ihi, error);
-    double v[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    double v[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
     for (int k = 0; k < narg - 1; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
-    if (v[7] != 0.0 && v[7] != 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 or 1");
+    if (v[7] < 0.0 || v[7] > 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: beta must be in [0, 1]");
+    if (v[8] != 0.0 && v[8] != 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 or 1");
     if (v[0] <= 0.0 || v[1] <= 0.0 || v[2] <= 0.0 || v[3] <= 0.0 || v[4] < 0.0 || v[5] < 0.0 || v[6] < 0.0)
       error->all(FLERR, "bond_coeff for deckgen/flatjoint: E_b, kappa, lambda, sigma_c > 0; c, mu, zeta >= 0");
     for (int t = ilo; t <= ihi; t++) {
-      for (int k = 0; k < 8; k++) coeffs[t][k] = v[k];
+      for (int k = 0; k < 9; k++) coeffs[t][k] = v[k];
       setflag[t] = 1;
     }
   }
@@ -235,7 +237,7 @@ class BondFlatJoint : public Bond {
   }
 
  private:
-  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta slit
+  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta beta slit
   std::string filename;
   FILE *out = nullptr;
   std::vector<Joint> joints;
@@ -250,7 +252,7 @@ class BondFlatJoint : public Bond {
     allocated = 1;
     const int nt = atom->nbondtypes;
     memory->create(setflag, nt + 1, "bond:setflag");
-    memory->create(coeffs, nt + 1, 8, "bond:coeffs");
+    memory->create(coeffs, nt + 1, 9, "bond:coeffs");
     for (int t = 0; t <= nt; t++) setflag[t] = 0;
   }
 
@@ -270,7 +272,7 @@ class BondFlatJoint : public Bond {
     b.tag_i = atom->tag[i];
     b.tag_j = atom->tag[j];
     b.type = type;
-    b.broken = coeffs[type][7] > 0.0;    // slit: broken from the start
+    b.broken = coeffs[type][8] > 0.0;    // slit: broken from the start
     double d[3] = {atom->x[j][0] - atom->x[i][0], atom->x[j][1] - atom->x[i][1], atom->x[j][2] - atom->x[i][2]};
     b.r0 = norm3(d);
     const double *c = coeffs[type];
@@ -331,8 +333,9 @@ class BondFlatJoint : public Bond {
 
     bool breaks = false;
     if (!b.broken) {
-      const double sigma = fn / b.area + norm3(b.mb) * b.rb / b.inertia;
-      const double tau = norm3(b.fs) / b.area + std::fabs(b.mt) * b.rb / b.polar;
+      const double beta = c[7];
+      const double sigma = fn / b.area + beta * norm3(b.mb) * b.rb / b.inertia;
+      const double tau = norm3(b.fs) / b.area + beta * std::fabs(b.mt) * b.rb / b.polar;
       const double tau_c = c[4] + mu * std::fmax(0.0, -fn / b.area);
       int mode = 0;
       if (sigma >= c[3]) mode = 1;

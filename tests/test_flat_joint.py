@@ -34,16 +34,22 @@ needs_engine = pytest.mark.skipif(not (engine_available() and have_compiler),
 
 # two grains of radius 1 mm, density 2500, touching; the bond law's numbers
 R, RHO = 1e-3, 2500.0
-E_B, KAPPA, LAM, SIGMA_C, COH, MU, BETA = 1e9, 2.5, 1.0, 1e6, 2e6, 0.5, 1.0
+E_B, KAPPA, LAM, SIGMA_C, COH, MU = 1e9, 2.5, 1.0, 1e6, 2e6, 0.5
 AREA = math.pi * (LAM * R) ** 2
 K_N = E_B / (2 * R) * AREA  # N/m
 DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
 
 
-def _two_grains(tmp: Path, moves: list[tuple[float, float, int]]) -> np.ndarray:
-    """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs; returns rows step, fx2, fy2 every step."""
+def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 1.0,
+                spin_period_s: float = 0.0) -> np.ndarray:
+    """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs (or, with ``spin_period_s``, turned about its own
+    centre and the z axis for ``steps``); returns rows step, fx2, fy2 every step."""
     lib = plugins.install(tmp, "flatjoint")
-    legs = "\n".join(f"fix m g2 move linear {vx:.10g} {vy:.10g} 0\nrun {n}\nunfix m" for vx, vy, n in moves)
+    if spin_period_s:
+        legs = "\n".join(f"fix m g2 move rotate {2 * R:.10g} 0 0 0 0 1 {spin_period_s:.10g}\nrun {n}\nunfix m"
+                         for _, _, n in moves)
+    else:
+        legs = "\n".join(f"fix m g2 move linear {vx:.10g} {vy:.10g} 0\nrun {n}\nunfix m" for vx, vy, n in moves)
     (tmp / "in.two").write_text(f"""plugin load {lib}
 units si
 atom_style bpm/sphere
@@ -59,7 +65,7 @@ set type 1 density {RHO:.10g}
 pair_style granular
 pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
 bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
-bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {BETA:.10g}
+bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {beta:.10g}
 create_bonds single/bond 1 1 2
 group g2 id 2
 timestep {DT:.10g}
@@ -115,6 +121,19 @@ def test_shear_strength_is_cohesion_plus_friction_times_compression(tmp_path, sq
         assert np.allclose(np.abs(tail[:, 2]), MU * tail[:, 1], rtol=0.05)
     else:  # nothing presses the broken face: no shear either
         assert np.all(np.abs(tail[:, 2]) < 1e-9)
+
+
+@needs_engine
+@pytest.mark.parametrize("beta", [1.0, 0.0])
+def test_bending_breaks_in_tension_unless_the_moment_contribution_is_zero(tmp_path, beta):
+    omega = 10.0  # rad/s: 1e-6 rad per step
+    _two_grains(tmp_path, [(0.0, 0.0, 12000)], beta=beta, spin_period_s=2 * math.pi / omega)
+    (brk,) = _breaks(tmp_path)
+    theta = (int(brk[0]) - 1) * DT * omega  # relative rotation at the break
+    if beta:  # k_n I theta R_b / I = sigma_c  ->  theta = sigma_c r0 / (E_b R_b) = 2e-3 rad
+        assert brk[3] == "1" and theta == pytest.approx(SIGMA_C * 2 * R / (E_B * LAM * R), rel=0.01)
+    else:  # only the shear at the face (k_s A R theta) breaks it: theta = c r0 kappa / (E_b R) = 1e-2 rad
+        assert brk[3] == "2" and theta == pytest.approx(COH * 2 * R * KAPPA / (E_B * R), rel=0.01)
 
 
 def test_flat_joint_validation_names_field_and_fix():

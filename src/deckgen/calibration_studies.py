@@ -173,6 +173,15 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     # UCS scaled with sigma_c (tension breaks, bending included): PFC's moment-contribution factor beta
     ("flat joint, mu 0.5, beta 0.5", {"flat_joint": 1, "moment_contribution": 0.5}),
     ("flat joint, mu 0.5, beta 0", {"flat_joint": 1, "moment_contribution": 0.0}),
+    # the face radius: rocking limit |F_n| R_b, bending stiffness ~ R_b^4
+    ("flat joint, mu 0.5, bond radius x2", {"flat_joint": 1, "radius_multiplier": 2.0}),
+    # the best M so far (c/sigma 2) pushed: a higher cohesion, and with more friction
+    ("flat joint, mu 0.5, c/sigma 4", {"flat_joint": 1, "shear_strength_MPa": 240.0}),
+    ("flat joint, mu 1.0, c/sigma 2", {"flat_joint": 1, "joint_friction": 1.0, "shear_strength_MPa": 120.0}),
+    # beta 0 gave the highest M (7.9 %): with the other knobs that raised M
+    ("flat joint, beta 0, c/sigma 2", {"flat_joint": 1, "moment_contribution": 0.0, "shear_strength_MPa": 120.0}),
+    ("flat joint, beta 0, mu 1.0", {"flat_joint": 1, "moment_contribution": 0.0, "joint_friction": 1.0}),
+    ("flat joint, beta 0, slits 0.5", {"flat_joint": 1, "moment_contribution": 0.0, "unbonded_fraction": 0.5}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -182,6 +182,12 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("flat joint, beta 0, c/sigma 2", {"flat_joint": 1, "moment_contribution": 0.0, "shear_strength_MPa": 120.0}),
     ("flat joint, beta 0, mu 1.0", {"flat_joint": 1, "moment_contribution": 0.0, "joint_friction": 1.0}),
     ("flat joint, beta 0, slits 0.5", {"flat_joint": 1, "moment_contribution": 0.0, "unbonded_fraction": 0.5}),
+    # beta 0 (M 7.9 %), mu 1 with c/sigma 2 (8.6 %) and the bond radius x2 (8.2 %) together
+    ("flat joint, beta 0, mu 1.0, c/sigma 2", {"flat_joint": 1, "moment_contribution": 0.0, "joint_friction": 1.0,
+                                               "shear_strength_MPa": 120.0}),
+    ("flat joint, beta 0, mu 1.0, c/sigma 2, bond radius x2", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                               "joint_friction": 1.0, "shear_strength_MPa": 120.0,
+                                                               "radius_multiplier": 2.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

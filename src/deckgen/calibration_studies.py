@@ -185,9 +185,9 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     # beta 0 (M 7.9 %), mu 1 with c/sigma 2 (8.6 %) and the bond radius x2 (8.2 %) together
     ("flat joint, beta 0, mu 1.0, c/sigma 2", {"flat_joint": 1, "moment_contribution": 0.0, "joint_friction": 1.0,
                                                "shear_strength_MPa": 120.0}),
-    ("flat joint, beta 0, mu 1.0, c/sigma 2, bond radius x2", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                               "joint_friction": 1.0, "shear_strength_MPa": 120.0,
-                                                               "radius_multiplier": 2.0}),
+    # beta 0, c/sigma 2 gave M 12.8 % at UCS/BTS 5.8: does a lower sigma_c (c 120 MPa kept) trade UCS/E for UCS/BTS?
+    ("flat joint, beta 0, sigma_c 30, c 120 (c/sigma 4)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                           "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

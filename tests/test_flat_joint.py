@@ -41,9 +41,11 @@ DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
 
 
 def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 1.0,
-                spin_period_s: float = 0.0) -> np.ndarray:
+                spin_period_s: float = 0.0, sectors: int = 1) -> np.ndarray:
     """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs (or, with ``spin_period_s``, turned about its own
-    centre and the z axis for ``steps``); returns rows step, fx2, fy2 every step."""
+    centre and the z axis for ``steps``); ``sectors`` > 1: a face of that many elements in one ring; returns rows
+    step, fx2, fy2 every step."""
+    elements = f" 0 {sectors} 1" if sectors > 1 else ""
     lib = plugins.install(tmp, "flatjoint")
     if spin_period_s:
         legs = "\n".join(f"fix m g2 move rotate {2 * R:.10g} 0 0 0 0 1 {spin_period_s:.10g}\nrun {n}\nunfix m"
@@ -65,7 +67,7 @@ set type 1 density {RHO:.10g}
 pair_style granular
 pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
 bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
-bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {beta:.10g}
+bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {beta:.10g}{elements}
 create_bonds single/bond 1 1 2
 group g2 id 2
 timestep {DT:.10g}
@@ -136,6 +138,34 @@ def test_bending_breaks_in_tension_unless_the_moment_contribution_is_zero(tmp_pa
         assert brk[3] == "2" and theta == pytest.approx(COH * 2 * R * KAPPA / (E_B * R), rel=0.01)
 
 
+@needs_engine
+def test_a_face_of_elements_breaks_in_tension_at_sigma_c_all_at_once(tmp_path):
+    v = STEP / DT
+    f = _two_grains(tmp_path, [(v, 0.0, 3000)], sectors=4)
+    assert -f[:, 1].min() == pytest.approx(SIGMA_C * AREA, rel=2e-3)  # uniform stretch: every element at sigma_c
+    (brk,) = _breaks(tmp_path)
+    assert brk[3] == "1" and 1990 <= int(brk[0]) <= 2010
+
+
+@needs_engine
+def test_a_bent_face_of_elements_breaks_element_by_element(tmp_path):
+    """Four elements at the ring's radius of gyration R/sqrt(2), at 45, 135, 225, 315 degrees from the bending
+    axis' normal: turning grain 2 about z opens the two elements on one side, which break in tension at
+    theta = sigma_c r0 / (E_b R/2) = 4e-3 rad (twice the one-element face's 2e-3: its rim is at R); the face then
+    presses on the other two (the normal force jumps from 0 to a push), and they break in shear at
+    k_s R theta = c + mu k_n (R/2) theta, theta = c r0 / (E_b R (1/kappa - mu/2)) = 2.67e-2 rad."""
+    omega = 10.0  # rad/s: 1e-6 rad per step
+    f = _two_grains(tmp_path, [(0.0, 0.0, 30000)], spin_period_s=2 * math.pi / omega, sectors=4)
+    theta = f[:, 0] * DT * omega
+    push = f[:, 1] > 1e-3 * SIGMA_C * AREA  # compression pushes grain 2 to +x
+    first = theta[np.argmax(push)]
+    assert first == pytest.approx(SIGMA_C * 2 * R / (E_B * R / 2), rel=0.01)
+    assert not push[theta < 0.99 * first].any()  # bending alone leaves no net normal force while all hold
+    (brk,) = _breaks(tmp_path)  # one line: the joint, when its last element breaks
+    theta_last = (int(brk[0]) - 1) * DT * omega
+    assert brk[3] == "2" and theta_last == pytest.approx(COH * 2 * R / (E_B * R * (1 / KAPPA - MU / 2)), rel=0.01)
+
+
 def test_flat_joint_validation_names_field_and_fix():
     case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
     assert resolved_dict(case)["bonds"]["model"] == "flat_joint"
@@ -148,6 +178,15 @@ def test_flat_joint_validation_names_field_and_fix():
         load_case(CASES / "tiny_ucs.yaml", overrides={**FJ, "engine": "liggghts"})
     with pytest.raises(SpecError, match="model"):
         load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint; shell rm -rf /"}})
+    with pytest.raises(SpecError, match="face_sectors: used only by model: flat_joint"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"face_sectors": 4}})
+    with pytest.raises(SpecError, match="face_sectors: 2 halves"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "face_sectors": 2}})
+    with pytest.raises(SpecError, match="face_rings: 2 rings need face_sectors"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "face_rings": 2}})
+    with pytest.raises(SpecError, match="moment_contribution: used by the one-element face only"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "face_sectors": 4,
+                                                                "moment_contribution": 0.0}})
 
 
 def test_micro_params_keep_their_keys_and_map_the_flat_joint():
@@ -159,6 +198,10 @@ def test_micro_params_keep_their_keys_and_map_the_flat_joint():
     assert q.key() != p.key()
     assert "model" not in p.overrides()["bonds"]
     assert q.overrides()["bonds"]["model"] == "flat_joint" and q.overrides()["bonds"]["joint_friction"] == 0.5
+    assert "face_sectors" not in q.overrides()["bonds"]
+    e = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0, flat_joint=1,
+                    face_sectors=4)
+    assert e.key() != q.key() and e.overrides()["bonds"]["face_sectors"] == 4
 
 
 @pytest.mark.skipif(not have_compiler, reason="no C++ compiler for the plugin (apt-get install g++)")
@@ -191,10 +234,13 @@ def test_broken_joints_file_is_read_with_modes_and_fails_with_file_and_line(tmp_
 
 
 @needs_engine
-@pytest.mark.parametrize("slits", [0.0, 0.5])
-def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits):
-    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "unbonded_fraction": slits}})
+@pytest.mark.parametrize("slits,sectors", [(0.0, 1), (0.5, 1), (0.5, 4)])
+def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits, sectors):
+    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "unbonded_fraction": slits,
+                                                                   "face_sectors": sectors}})
     spec = render_case(case, tmp_path, progress=False)
+    if sectors > 1:
+        assert " 0 4 1\n" in (tmp_path / "in.deck").read_text() and " 1 4 1\n" in (tmp_path / "in.deck").read_text()
     if slits:  # the unbonded pairs are slit faces: bonds of one more type, broken from the start, never counted
         n_slit = spec["derived"]["unbonded"]["slit_faces"]
         assert n_slit == spec["derived"]["unbonded"]["unbonded_pairs"] > 0

@@ -330,6 +330,7 @@ class MicroParams:
     flat_joint: int = 0  # 1: bonds.model flat_joint (deckgen's plugin bond), 0: bpm_rotational
     joint_friction: float = 0.5  # bonds.joint_friction (flat joint only)
     moment_contribution: float = 1.0  # bonds.moment_contribution (flat joint only)
+    face_sectors: int = 1  # bonds.face_sectors (flat joint only; 1 = the one-element face)
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -354,9 +355,12 @@ class MicroParams:
             if vals[name] == default:
                 del vals[name]
         if vals["flat_joint"] == 0:  # bpm_rotational points keep the keys they had before the flat joint
-            del vals["flat_joint"], vals["joint_friction"], vals["moment_contribution"]
-        elif vals["moment_contribution"] == 1.0:  # flat-joint points recorded before beta existed
-            del vals["moment_contribution"]
+            del vals["flat_joint"], vals["joint_friction"], vals["moment_contribution"], vals["face_sectors"]
+        else:
+            if vals["moment_contribution"] == 1.0:  # flat-joint points recorded before beta existed
+                del vals["moment_contribution"]
+            if vals["face_sectors"] == 1:  # ... and before faces of several elements
+                del vals["face_sectors"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
@@ -375,6 +379,8 @@ class MicroParams:
             bonds.update(model="flat_joint", joint_friction=self.joint_friction)
             if self.moment_contribution != 1.0:
                 bonds["moment_contribution"] = self.moment_contribution
+            if self.face_sectors != 1:
+                bonds["face_sectors"] = int(self.face_sectors)
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

@@ -188,6 +188,26 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     # beta 0, c/sigma 2 gave M 12.8 % at UCS/BTS 5.8: does a lower sigma_c (c 120 MPa kept) trade UCS/E for UCS/BTS?
     ("flat joint, beta 0, sigma_c 30, c 120 (c/sigma 4)", {"flat_joint": 1, "moment_contribution": 0.0,
                                                            "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0}),
+    ("flat joint, beta 0, sigma_c 15, c 120 (c/sigma 8)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                           "tensile_strength_MPa": 15.0, "shear_strength_MPa": 120.0}),
+    # bpm/rotational's UCS/BTS rose as the failure strain fell: beta 0, c/sigma 2 at half and a quarter of the strengths
+    ("flat joint, beta 0, sigma_c 30, c 60 (c/sigma 2)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                          "tensile_strength_MPa": 30.0}),
+    ("flat joint, beta 0, sigma_c 15, c 30 (c/sigma 2)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                          "tensile_strength_MPa": 15.0, "shear_strength_MPa": 30.0}),
+    # the interaction range (Scholtes & Donze 2013) with the flat joint's faces
+    ("flat joint, beta 0, c/sigma 2, g 0.2", {"flat_joint": 1, "moment_contribution": 0.0, "shear_strength_MPa": 120.0,
+                                              "gap_tolerance": 0.2}),
+    ("flat joint, beta 0, c/sigma 2, g 0.6", {"flat_joint": 1, "moment_contribution": 0.0, "shear_strength_MPa": 120.0,
+                                              "gap_tolerance": 0.6}),
+    # faces of several elements (bonds.face_sectors, one ring): a partly broken face keeps resisting bending
+    ("flat joint, sectors 3", {"flat_joint": 1, "face_sectors": 3}),
+    ("flat joint, sectors 4", {"flat_joint": 1, "face_sectors": 4}),
+    ("flat joint, sectors 8", {"flat_joint": 1, "face_sectors": 8}),
+    ("flat joint, sectors 4, c/sigma 2", {"flat_joint": 1, "face_sectors": 4, "shear_strength_MPa": 120.0}),
+    ("flat joint, sectors 4, mu 1.0", {"flat_joint": 1, "face_sectors": 4, "joint_friction": 1.0}),
+    ("flat joint, sectors 4, slits 0.25", {"flat_joint": 1, "face_sectors": 4, "unbonded_fraction": 0.25}),
+    ("flat joint, sectors 4, sigma_c 30", {"flat_joint": 1, "face_sectors": 4, "tensile_strength_MPa": 30.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

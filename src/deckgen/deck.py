@@ -514,7 +514,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                   b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio,
                   b.moment_contribution]
         ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
-                             "slit_type": table.ntypes + 1 if len(slits) else None}
+                             "slit_type": table.ntypes + 1 if len(slits) else None,
+                             "elements": [b.face_sectors, b.face_rings] if b.face_sectors > 1 else []}
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
         "omega_translational_rad_s": dt_info["omega_translational_rad_s"],

@@ -174,6 +174,18 @@ class Bonds(_Model):
         "beta |M_b| R_b/I and tau = |F_s|/A + beta |M_t| R_b/J (PFC's parallel bond; 1: bending and twisting load the "
         "bond's rim fully, 0: only forces break bonds). Written to spec.json only when not 1.",
     )
+    face_sectors: int = Field(
+        1, ge=1, le=16, exclude_if=lambda v: v == 1, json_schema_extra={"unit": "1"},
+        description="flat_joint only: 1 = the face is one element (checked with moment_contribution); 3-16 = the "
+        "face disc is cut into face_rings x face_sectors elements that bond, break and press one by one (Potyondy "
+        "2012's flat joint proper): a partly broken face still resists bending with its intact elements, and a "
+        "broken face rocks on its elements. Written to spec.json only when not 1.",
+    )
+    face_rings: int = Field(
+        1, ge=1, le=4, exclude_if=lambda v: v == 1, json_schema_extra={"unit": "1"},
+        description="flat_joint with face_sectors > 1: rings of elements on the face (equal widths). Written to "
+        "spec.json only when not 1.",
+    )
     joint_friction: float = Field(
         0.5, ge=0, le=5, exclude_if=lambda v: v == 0.5, json_schema_extra={"unit": "1"},
         description="flat_joint only: friction coefficient of the intact bond's Mohr-Coulomb shear strength and of "
@@ -200,9 +212,19 @@ class Bonds(_Model):
                 if value != plain:
                     raise ValueError(f"{field}: not available with model: flat_joint, whose bonds all share one law "
                                      f"(fix: {field}: {plain:g}, or model: bpm_rotational)")
+            if self.face_sectors == 2:
+                raise ValueError("face_sectors: 2 halves give a face that bends more easily one way than the other "
+                                 "(fix: 1 for one element, or 3-16)")
+            if self.face_rings > 1 and self.face_sectors == 1:
+                raise ValueError(f"face_rings: {self.face_rings} rings need face_sectors of 3 or more (fix: face_rings: "
+                                 "1, or face_sectors: 3-16)")
+            if self.face_sectors > 1 and self.moment_contribution != 1.0:
+                raise ValueError("moment_contribution: used by the one-element face only; a face of elements "
+                                 "resolves the moments itself (fix: remove moment_contribution, or face_sectors: 1)")
         else:
             for field, value, plain in (("joint_friction", self.joint_friction, 0.5),
-                                        ("moment_contribution", self.moment_contribution, 1.0)):
+                                        ("moment_contribution", self.moment_contribution, 1.0),
+                                        ("face_sectors", self.face_sectors, 1), ("face_rings", self.face_rings, 1)):
                 if value != plain:
                     raise ValueError(f"{field}: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
         return self

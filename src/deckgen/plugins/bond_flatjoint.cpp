@@ -31,8 +31,24 @@
    and after breakage. Broken joints are kept by this style; their bond type is set to 0 so
    compute nbond/atom counts intact bonds only.
 
+   Faces of several elements (Potyondy's flat joint proper; sectors > 1): the face disc is cut into
+   rings x sectors elements of equal angle, ring k spanning R_b k/rings .. R_b (k+1)/rings. Each element is a
+   point spring at its ring's radius of gyration sqrt((r1^2 + r2^2)/2) and the middle angle of its sector, so
+   the face's bending and polar stiffnesses are exactly k_n I and k_s J for sectors >= 3. The face turns with
+   the mean rotation of the two grains (an in-plane frame vector carried along). Element e at p_e (in the
+   face plane) of area A_e = A/(rings sectors):
+     normal   f_e = k_n A_e (r - r0 + theta_b . (p_e x n))    theta_b: relative bending rotation, j to i
+     shear    F_e += -k_s A_e (v_t + w_t n x p_e) dt
+   Bonded element: tension break if f_e/A_e >= sigma_c, shear break if |F_e|/A_e >= c + mu max(0, -f_e/A_e).
+   Unbonded element (broken, or slit): no tension (open: no load), |F_e| <= mu |f_e| in compression.
+   The joint's force is the sum of the element forces, its moment sum p_e x (element force), so a face that
+   has lost some elements still resists bending with the rest, and a broken face rocks about its elements.
+   beta is not used (the elements resolve the moments). A joint counts as broken, and is listed, when its
+   last bonded element breaks (mode: that element's).
+
    Syntax:  bond_style deckgen/flatjoint FILE          (FILE: broken bonds, one line each, appended)
-            bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit]   (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1)
+            bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings]]
+            (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1; sectors 1 (one element, the law above) or 3-16; rings 1-4)
    A bond type with slit 1 holds faces that are broken from the start: closed, cohesionless contacts with the
    broken face's law (the slit elements of Potyondy's flat joint); they are neither counted nor listed as breaks.
    Serial only (one MPI rank): bond states live in this object, keyed by atom tags.
@@ -80,10 +96,20 @@ typedef void (*lammpsplugin_regfunc)(lammpsplugin_t *, void *);
 
 namespace {
 
+struct Element {
+  double rho, phi, area;    // radius of gyration of its ring, middle angle of its sector, area
+  bool bonded;
+  double fs[3];             // shear force on j [N]
+};
+
 struct Joint {
   tagint tag_i, tag_j;
   int type;
   bool broken;
+  int nbonded;              // faces of several elements: bonded elements left
+  double theta[3];          // relative bending rotation of j to i (in the face plane) [rad]
+  double e1[3];             // in-plane frame vector that turns with the face
+  std::vector<Element> el;  // empty: the one-element face
   double r0, rb, area, inertia, polar;
   double kn, ks, kt, kb;    // N/m, N/m, N m/rad, N m/rad
   double fs[3];             // shear force on j [N]
@@ -148,19 +174,22 @@ class BondFlatJoint : public Bond {
 
   void coeff(int narg, char **arg) override
   {
-    if (narg != 9 && narg != 10)
-      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta beta [slit]");
+    if (narg != 9 && narg != 10 && narg != 12)
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings]]");
     if (!allocated) allocate();
     int ilo, ihi;
     utils::bounds(FLERR, arg[0], 1, atom->nbondtypes, ilo, ihi, error);
-    double v[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    double v[NCOEFF] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1};
     for (int k = 0; k < narg - 1; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
     if (v[7] < 0.0 || v[7] > 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: beta must be in [0, 1]");
     if (v[8] != 0.0 && v[8] != 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 or 1");
+    if (v[9] != std::floor(v[9]) || v[10] != std::floor(v[10]) || !(v[9] == 1.0 || (v[9] >= 3.0 && v[9] <= 16.0)) ||
+        v[10] < 1.0 || v[10] > 4.0 || (v[9] == 1.0 && v[10] != 1.0))
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: sectors 1 (one element) or 3-16, rings 1-4 (1 with one sector)");
     if (v[0] <= 0.0 || v[1] <= 0.0 || v[2] <= 0.0 || v[3] <= 0.0 || v[4] < 0.0 || v[5] < 0.0 || v[6] < 0.0)
       error->all(FLERR, "bond_coeff for deckgen/flatjoint: E_b, kappa, lambda, sigma_c > 0; c, mu, zeta >= 0");
     for (int t = ilo; t <= ihi; t++) {
-      for (int k = 0; k < 9; k++) coeffs[t][k] = v[k];
+      for (int k = 0; k < NCOEFF; k++) coeffs[t][k] = v[k];
       setflag[t] = 1;
     }
   }
@@ -237,7 +266,8 @@ class BondFlatJoint : public Bond {
   }
 
  private:
-  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta beta slit
+  static constexpr int NCOEFF = 11;
+  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta beta slit sectors rings
   std::string filename;
   FILE *out = nullptr;
   std::vector<Joint> joints;
@@ -252,7 +282,7 @@ class BondFlatJoint : public Bond {
     allocated = 1;
     const int nt = atom->nbondtypes;
     memory->create(setflag, nt + 1, "bond:setflag");
-    memory->create(coeffs, nt + 1, 9, "bond:coeffs");
+    memory->create(coeffs, nt + 1, NCOEFF, "bond:coeffs");
     for (int t = 0; t <= nt; t++) setflag[t] = 0;
   }
 
@@ -285,6 +315,32 @@ class BondFlatJoint : public Bond {
     b.ks = ks_area * b.area;
     b.kt = ks_area * b.polar;
     b.kb = kn_area * b.inertia;
+    const int sectors = static_cast<int>(c[9]), rings = static_cast<int>(c[10]);
+    if (sectors > 1) {
+      const double n[3] = {d[0] / b.r0, d[1] / b.r0, d[2] / b.r0};
+      // any in-plane start vector: the axis least aligned with n, made normal to n
+      double a[3] = {0.0, 0.0, 0.0};
+      int kmin = 0;
+      for (int k = 1; k < 3; k++)
+        if (std::fabs(n[k]) < std::fabs(n[kmin])) kmin = k;
+      a[kmin] = 1.0;
+      const double an = dot3(a, n);
+      for (int k = 0; k < 3; k++) b.e1[k] = a[k] - an * n[k];
+      const double e = norm3(b.e1);
+      for (int k = 0; k < 3; k++) b.e1[k] /= e;
+      for (int ring = 0; ring < rings; ring++) {
+        const double r1 = b.rb * ring / rings, r2 = b.rb * (ring + 1) / rings;
+        for (int s = 0; s < sectors; s++) {
+          Element el{};
+          el.rho = std::sqrt(0.5 * (r1 * r1 + r2 * r2));
+          el.phi = 2.0 * M_PI * (s + 0.5) / sectors;
+          el.area = M_PI * (r2 * r2 - r1 * r1) / sectors;
+          el.bonded = !b.broken;
+          b.el.push_back(el);
+        }
+      }
+      b.nbonded = b.broken ? 0 : static_cast<int>(b.el.size());
+    }
     joints.push_back(b);
     index[k] = joints.size() - 1;
     return joints.size() - 1;
@@ -293,6 +349,7 @@ class BondFlatJoint : public Bond {
   // Forces and torques of joint b on grains i and j; returns true when an intact joint breaks now.
   bool interact(Joint &b, int i, int j)
   {
+    if (!b.el.empty()) return interact_elements(b, i, j);
     double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
     const double *radius = atom->radius, *rmass = atom->rmass;
     const double *c = coeffs[b.type];
@@ -390,6 +447,139 @@ class BondFlatJoint : public Bond {
       // force on i and the vector from j to i, as LAMMPS' bond tally expects
       ev_tally_xyz(i, j, atom->nlocal, force->newton_bond, 0.0, -Fj[0], -Fj[1], -Fj[2], -d[0], -d[1], -d[2]);
     }
+    return breaks;
+  }
+
+  // A face of several elements (sectors > 1): forces and torques on i and j; true when its last bonded element breaks.
+  bool interact_elements(Joint &b, int i, int j)
+  {
+    double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+    const double *radius = atom->radius, *rmass = atom->rmass;
+    const double *c = coeffs[b.type];
+    const double sigma_c = c[3], coh = c[4], mu = c[5], zeta = c[6], dt = update->dt;
+    const double kn_area = b.kn / b.area, ks_area = b.ks / b.area;
+
+    double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
+    const double r = norm3(d);
+    if (r <= 0.0) error->one(FLERR, "bond_style deckgen/flatjoint: two bonded grains at one point");
+    const double n[3] = {d[0] / r, d[1] / r, d[2] / r};
+    const double ri = r * radius[i] / (radius[i] + radius[j]), rj = r - ri;
+    double wi[3], wj[3], vrel[3];
+    cross3(omega[i], n, wi);
+    cross3(omega[j], n, wj);
+    for (int k = 0; k < 3; k++) vrel[k] = v[j][k] - v[i][k] - ri * wi[k] - rj * wj[k];
+    const double vn = dot3(vrel, n);
+    double vt[3], wrel[3], wb[3], wmean[3];
+    for (int k = 0; k < 3; k++) vt[k] = vrel[k] - vn * n[k];
+    for (int k = 0; k < 3; k++) wrel[k] = omega[j][k] - omega[i][k];
+    const double wt = dot3(wrel, n);
+    for (int k = 0; k < 3; k++) wb[k] = wrel[k] - wt * n[k];
+    for (int k = 0; k < 3; k++) wmean[k] = 0.5 * (omega[i][k] + omega[j][k]);
+
+    // the face frame turns with the grains' mean rotation, then back into the plane normal to n
+    double de[3];
+    cross3(wmean, b.e1, de);
+    for (int k = 0; k < 3; k++) b.e1[k] += de[k] * dt;
+    const double e1n = dot3(b.e1, n);
+    for (int k = 0; k < 3; k++) b.e1[k] -= e1n * n[k];
+    const double e1m = norm3(b.e1);
+    for (int k = 0; k < 3; k++) b.e1[k] /= e1m;
+    double e2[3];
+    cross3(n, b.e1, e2);
+    to_plane(b.theta, n);
+    for (int k = 0; k < 3; k++) b.theta[k] += wb[k] * dt;
+
+    const double dn = r - b.r0;
+    if (b.broken && dn >= 0.0) {    // a broken face with the centres apart is open, as the one-element face
+      for (auto &e : b.el)
+        for (int k = 0; k < 3; k++) e.fs[k] = 0.0;
+      for (int k = 0; k < 3; k++) b.theta[k] = 0.0;
+      return false;
+    }
+    double ftot[3] = {0.0, 0.0, 0.0}, mtot[3] = {0.0, 0.0, 0.0};
+    bool closed_any = false;
+    int mode_last = 0;
+    for (auto &e : b.el) {
+      double p[3], pxn[3], slip[3], tw[3];
+      const double cp = e.rho * std::cos(e.phi), sp = e.rho * std::sin(e.phi);
+      for (int k = 0; k < 3; k++) p[k] = cp * b.e1[k] + sp * e2[k];
+      cross3(p, n, pxn);
+      const double fe = kn_area * e.area * (dn + dot3(b.theta, pxn));    // tension positive
+      if (!e.bonded && fe >= 0.0) {    // open element: no load, nothing remembered
+        for (int k = 0; k < 3; k++) e.fs[k] = 0.0;
+        continue;
+      }
+      // slip of the element point: the face's tangential slip and the twist about n
+      const double wn[3] = {wt * n[0], wt * n[1], wt * n[2]};
+      cross3(wn, p, tw);
+      for (int k = 0; k < 3; k++) slip[k] = vt[k] + tw[k];
+      to_plane(e.fs, n);
+      for (int k = 0; k < 3; k++) e.fs[k] -= ks_area * e.area * slip[k] * dt;
+      if (e.bonded) {
+        const double sigma = fe / e.area, tau = norm3(e.fs) / e.area;
+        int mode = 0;
+        if (sigma >= sigma_c) mode = 1;
+        else if (tau >= coh + mu * std::fmax(0.0, -sigma)) mode = 2;
+        if (mode) {
+          e.bonded = false;
+          b.nbonded--;
+          mode_last = mode;
+          if (fe >= 0.0) {
+            for (int k = 0; k < 3; k++) e.fs[k] = 0.0;
+            continue;
+          }
+        }
+      }
+      if (!e.bonded) cap(e.fs, mu * (-fe));
+      closed_any = closed_any || fe < 0.0;
+      // on j: -fe n + fs at p (from the face centre)
+      double fj[3], m[3];
+      for (int k = 0; k < 3; k++) fj[k] = -fe * n[k] + e.fs[k];
+      cross3(p, fj, m);
+      for (int k = 0; k < 3; k++) {
+        ftot[k] += fj[k];
+        mtot[k] += m[k];
+      }
+    }
+    bool breaks = false;
+    if (!b.broken && b.nbonded == 0) {
+      breaks = true;
+      b.broken = true;
+      if (mode_last == 1) n_tension += 1.0;
+      else n_shear += 1.0;
+      if (out)
+        fprintf(out, "%lld %lld %lld %d %.9e %.9e %.9e\n", static_cast<long long>(update->ntimestep),
+                static_cast<long long>(b.tag_i), static_cast<long long>(b.tag_j), mode_last,
+                0.5 * (x[i][0] + x[j][0]), 0.5 * (x[i][1] + x[j][1]), 0.5 * (x[i][2] + x[j][2]));
+    }
+    if (b.broken && !closed_any) {    // an open broken face: no load, no bending remembered
+      for (int k = 0; k < 3; k++) b.theta[k] = 0.0;
+      return breaks;
+    }
+
+    // damping of the relative motion (not stored), while some element is bonded or closed
+    const double mstar = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+    const double Ii = 0.4 * rmass[i] * radius[i] * radius[i], Ij = 0.4 * rmass[j] * radius[j] * radius[j];
+    const double istar = Ii * Ij / (Ii + Ij);
+    const double gn = 2.0 * zeta * std::sqrt(mstar * b.kn), gs = 2.0 * zeta * std::sqrt(mstar * b.ks);
+    const double gb = 2.0 * zeta * std::sqrt(istar * b.kb), gt = 2.0 * zeta * std::sqrt(istar * b.kt);
+    double Fj[3], Ts[3], Mj[3], shear_on_j[3];
+    for (int k = 0; k < 3; k++) {
+      Fj[k] = ftot[k] - gn * vn * n[k] - gs * vt[k];
+      shear_on_j[k] = Fj[k] - dot3(Fj, n) * n[k];
+      Mj[k] = mtot[k] - gt * wt * n[k] - gb * wb[k];
+    }
+    for (int k = 0; k < 3; k++) {
+      f[j][k] += Fj[k];
+      f[i][k] -= Fj[k];
+    }
+    cross3(n, shear_on_j, Ts);
+    for (int k = 0; k < 3; k++) {
+      torque[j][k] += -rj * Ts[k] + Mj[k];
+      torque[i][k] += -ri * Ts[k] - Mj[k];
+    }
+    if (evflag)
+      ev_tally_xyz(i, j, atom->nlocal, force->newton_bond, 0.0, -Fj[0], -Fj[1], -Fj[2], -d[0], -d[1], -d[2]);
     return breaks;
   }
 };

@@ -41,11 +41,11 @@ DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
 
 
 def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 1.0,
-                spin_period_s: float = 0.0, sectors: int = 1) -> np.ndarray:
+                spin_period_s: float = 0.0, sectors: int = 1, gap: float = 0.0, slit: int = 0) -> np.ndarray:
     """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs (or, with ``spin_period_s``, turned about its own
-    centre and the z axis for ``steps``); ``sectors`` > 1: a face of that many elements in one ring; returns rows
-    step, fx2, fy2 every step."""
-    elements = f" 0 {sectors} 1" if sectors > 1 else ""
+    centre and the z axis for ``steps``); ``sectors`` > 1: a face of that many elements in one ring; ``gap``: grain
+    2 starts that far from touching; ``slit``: the bond's slit code; returns rows step, fx2, fy2 every step."""
+    elements = f" {slit} {sectors} 1" if sectors > 1 else (f" {slit}" if slit else "")
     lib = plugins.install(tmp, "flatjoint")
     if spin_period_s:
         legs = "\n".join(f"fix m g2 move rotate {2 * R:.10g} 0 0 0 0 1 {spin_period_s:.10g}\nrun {n}\nunfix m"
@@ -61,7 +61,7 @@ comm_modify vel yes
 region b block -0.01 0.01 -0.01 0.01 -0.01 0.01
 create_box 1 b bond/types 1 extra/bond/per/atom 2 extra/special/per/atom 2
 create_atoms 1 single 0.0 0.0 0.0
-create_atoms 1 single {2 * R:.10g} 0.0 0.0
+create_atoms 1 single {2 * R + gap:.10g} 0.0 0.0
 set type 1 diameter {2 * R:.10g}
 set type 1 density {RHO:.10g}
 pair_style granular
@@ -166,6 +166,18 @@ def test_a_bent_face_of_elements_breaks_element_by_element(tmp_path):
     assert brk[3] == "2" and theta_last == pytest.approx(COH * 2 * R / (E_B * R * (1 / KAPPA - MU / 2)), rel=0.01)
 
 
+@needs_engine
+def test_a_gapped_face_carries_nothing_until_the_grains_touch(tmp_path):
+    v = STEP / DT
+    gap = 1e-6  # 1 um apart: 1000 steps of approach before contact, then 2 um of overlap
+    f = _two_grains(tmp_path, [(-v, 0.0, 3000), (v, 0.0, 4000)], gap=gap, slit=2)
+    steps, fx = f[:, 0], f[:, 1]
+    assert np.all(fx[steps <= 999] == 0.0)  # open: no force across the gap (no Hertz contact either)
+    assert fx[2999] == pytest.approx(K_N * 2e-6, rel=5e-3)  # touching at r0 = r1 + r2: k_n A overlap
+    assert np.all(fx[steps >= 4001 + 1000] == 0.0)  # pulled apart again: no tension
+    assert not _breaks(tmp_path)  # a gapped face is never a break
+
+
 def test_flat_joint_validation_names_field_and_fix():
     case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
     assert resolved_dict(case)["bonds"]["model"] == "flat_joint"
@@ -178,6 +190,9 @@ def test_flat_joint_validation_names_field_and_fix():
         load_case(CASES / "tiny_ucs.yaml", overrides={**FJ, "engine": "liggghts"})
     with pytest.raises(SpecError, match="model"):
         load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint; shell rm -rf /"}})
+    with pytest.raises(SpecError, match="face_gap_tolerance: 0.03 is not above gap_tolerance 0.05"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "gap_tolerance": 0.05,
+                                                                "face_gap_tolerance": 0.03}})
     with pytest.raises(SpecError, match="face_sectors: used only by model: flat_joint"):
         load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"face_sectors": 4}})
     with pytest.raises(SpecError, match="face_sectors: 2 halves"):
@@ -234,11 +249,15 @@ def test_broken_joints_file_is_read_with_modes_and_fails_with_file_and_line(tmp_
 
 
 @needs_engine
-@pytest.mark.parametrize("slits,sectors", [(0.0, 1), (0.5, 1), (0.5, 4)])
-def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits, sectors):
+@pytest.mark.parametrize("slits,sectors,gapped", [(0.0, 1, 0.0), (0.5, 1, 0.0), (0.5, 4, 0.0), (0.0, 1, 0.4)])
+def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits, sectors, gapped):
     case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "unbonded_fraction": slits,
-                                                                   "face_sectors": sectors}})
+                                                                   "face_sectors": sectors,
+                                                                   "face_gap_tolerance": gapped}})
     spec = render_case(case, tmp_path, progress=False)
+    if gapped:  # pairs with gaps beyond the bonding gap: one more bond type, written with slit code 2
+        assert spec["derived"]["gapped_faces"] > 0
+        assert f"bond_coeff      {spec['derived']['n_bond_types'] + 1} " in (tmp_path / "in.deck").read_text()
     if sectors > 1:
         assert " 0 4 1\n" in (tmp_path / "in.deck").read_text() and " 1 4 1\n" in (tmp_path / "in.deck").read_text()
     if slits:  # the unbonded pairs are slit faces: bonds of one more type, broken from the start, never counted

@@ -331,6 +331,7 @@ class MicroParams:
     joint_friction: float = 0.5  # bonds.joint_friction (flat joint only)
     moment_contribution: float = 1.0  # bonds.moment_contribution (flat joint only)
     face_sectors: int = 1  # bonds.face_sectors (flat joint only; 1 = the one-element face)
+    face_gap_tolerance: float = 0.0  # bonds.face_gap_tolerance (flat joint only; 0 = no gapped faces)
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -356,11 +357,14 @@ class MicroParams:
                 del vals[name]
         if vals["flat_joint"] == 0:  # bpm_rotational points keep the keys they had before the flat joint
             del vals["flat_joint"], vals["joint_friction"], vals["moment_contribution"], vals["face_sectors"]
+            del vals["face_gap_tolerance"]
         else:
             if vals["moment_contribution"] == 1.0:  # flat-joint points recorded before beta existed
                 del vals["moment_contribution"]
             if vals["face_sectors"] == 1:  # ... and before faces of several elements
                 del vals["face_sectors"]
+            if vals["face_gap_tolerance"] == 0.0:  # ... and before gapped faces
+                del vals["face_gap_tolerance"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
@@ -381,6 +385,8 @@ class MicroParams:
                 bonds["moment_contribution"] = self.moment_contribution
             if self.face_sectors != 1:
                 bonds["face_sectors"] = int(self.face_sectors)
+            if self.face_gap_tolerance != 0.0:
+                bonds["face_gap_tolerance"] = self.face_gap_tolerance
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa

@@ -201,13 +201,19 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("flat joint, beta 0, c/sigma 2, g 0.6", {"flat_joint": 1, "moment_contribution": 0.0, "shear_strength_MPa": 120.0,
                                               "gap_tolerance": 0.6}),
     # faces of several elements (bonds.face_sectors, one ring): a partly broken face keeps resisting bending
-    ("flat joint, sectors 3", {"flat_joint": 1, "face_sectors": 3}),
-    ("flat joint, sectors 4", {"flat_joint": 1, "face_sectors": 4}),
-    ("flat joint, sectors 8", {"flat_joint": 1, "face_sectors": 8}),
-    ("flat joint, sectors 4, c/sigma 2", {"flat_joint": 1, "face_sectors": 4, "shear_strength_MPa": 120.0}),
-    ("flat joint, sectors 4, mu 1.0", {"flat_joint": 1, "face_sectors": 4, "joint_friction": 1.0}),
-    ("flat joint, sectors 4, slits 0.25", {"flat_joint": 1, "face_sectors": 4, "unbonded_fraction": 0.25}),
-    ("flat joint, sectors 4, sigma_c 30", {"flat_joint": 1, "face_sectors": 4, "tensile_strength_MPa": 30.0}),
+    ("flat joint with 3 sectors", {"flat_joint": 1, "face_sectors": 3}),
+    ("flat joint with 4 sectors", {"flat_joint": 1, "face_sectors": 4}),
+    ("flat joint with 8 sectors", {"flat_joint": 1, "face_sectors": 8}),
+    ("flat joint with 4 sectors, c/sigma 2", {"flat_joint": 1, "face_sectors": 4, "shear_strength_MPa": 120.0}),
+    ("flat joint with 4 sectors, mu 1.0", {"flat_joint": 1, "face_sectors": 4, "joint_friction": 1.0}),
+    ("flat joint with 4 sectors, slits 0.25", {"flat_joint": 1, "face_sectors": 4, "unbonded_fraction": 0.25}),
+    ("flat joint with 4 sectors, sigma_c 30", {"flat_joint": 1, "face_sectors": 4, "tensile_strength_MPa": 30.0}),
+    # gapped faces (bonds.face_gap_tolerance; Potyondy's installation gap): near neighbours that are not bonded
+    # meet as flat faces once they touch, instead of round Hertz grains
+    ("flat joint gapped to 0.4, g 0.05", {"flat_joint": 1, "gap_tolerance": 0.05, "face_gap_tolerance": 0.4}),
+    ("flat joint gapped to 0.8", {"flat_joint": 1, "face_gap_tolerance": 0.8}),
+    ("flat joint gapped to 0.4, g 0.05, beta 0", {"flat_joint": 1, "gap_tolerance": 0.05, "face_gap_tolerance": 0.4,
+                                                  "moment_contribution": 0.0}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {

@@ -440,6 +440,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         pairs = pairs[~drop]
         if intra is not None:
             intra = intra[~drop]
+    gapped = pairs[:0]
+    if b.model == "flat_joint" and b.face_gap_tolerance > 0 and b.enabled:  # faces that close under load
+        wide = find_bond_pairs(atoms.x, r_full, b.face_gap_tolerance)
+        n_full = len(r_full)
+        gapped = wide[~np.isin(wide[:, 0] * n_full + wide[:, 1], all_pairs[:, 0] * n_full + all_pairs[:, 1])]
     strength = None
     if b.strength_weibull_modulus > 0 and b.enabled:  # weakest-link flaws: per-bond strength factors, mean 1
         strength = weibull_strength_factors(len(pairs), b.strength_weibull_modulus, seed=case.packing.seed)
@@ -454,9 +459,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
         strength_factor=strength, bins_strength=b.type_bins_strength)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
-    if len(slits):  # slit faces are as stiff as bonds in compression: the time step counts them too
+    if len(slits) or len(gapped):  # slit and gapped faces are as stiff as bonds in compression: the time step counts them
         dt_info = stable_timestep(atoms.x, r, mass, make_bond_table(
-            atoms.x, r, mass, all_pairs, E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
+            atoms.x, r, mass, np.concatenate([all_pairs, gapped]), E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
             sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
             radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
             bins_radius=b.type_bins_radius, bins_length=b.type_bins_length), run.timestep_safety)
@@ -515,6 +520,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                   b.moment_contribution]
         ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
                              "slit_type": table.ntypes + 1 if len(slits) else None,
+                             "gapped_type": table.ntypes + 1 + (1 if len(slits) else 0) if len(gapped) else None,
                              "elements": [b.face_sectors, b.face_rings] if b.face_sectors > 1 else []}
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
@@ -532,6 +538,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                                "bondable_pairs": n_unbonded + int(len(pairs))}
         if len(slits):
             derived["unbonded"]["slit_faces"] = int(len(slits))  # flat joint: written as bonds of the slit type
+    if len(gapped):
+        derived["gapped_faces"] = int(len(gapped))  # flat joint: bonds of the gapped type, open at the start
     if strength is not None:
         plain = np.ones(len(pairs), bool) if intra is None else ~intra
         binned = table.strength_factor[table.types[plain] - 1]  # the factor each bond gets in the deck: its type's mean
@@ -714,9 +722,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         template = "lammps/cutting.lmp.j2"
 
     write_bpm_data(out / DATA, title=f"deckgen {case.name}", box=box, types=types, radius=r_all, density=rho_all,
-                   x=x_all, n_atom_types=n_atom_types, bonds=np.concatenate([table.pairs, slits]),
-                   bond_types=np.concatenate([table.types, np.full(len(slits), table.ntypes + 1, table.types.dtype)]),
-                   n_bond_types=table.ntypes + (1 if len(slits) else 0), extra_bond_per_atom=2)
+                   x=x_all, n_atom_types=n_atom_types, bonds=np.concatenate([table.pairs, slits, gapped]),
+                   bond_types=np.concatenate([table.types, np.full(len(slits), table.ntypes + 1, table.types.dtype),
+                                              np.full(len(gapped), table.ntypes + 1 + (1 if len(slits) else 0),
+                                                      table.types.dtype)]),
+                   n_bond_types=table.ntypes + (1 if len(slits) else 0) + (1 if len(gapped) else 0), extra_bond_per_atom=2)
     ctx.update({"title": title, "template": template.split("/", 1)[1], "variables": variables})
     (out / DECK).write_text(render(template, ctx))
     spec = {"deckgen_version": __version__, "engine": "lammps", "case": resolved_dict(case), "derived": derived}

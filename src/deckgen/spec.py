@@ -181,6 +181,13 @@ class Bonds(_Model):
         "2012's flat joint proper): a partly broken face still resists bending with its intact elements, and a "
         "broken face rocks on its elements. Written to spec.json only when not 1.",
     )
+    face_gap_tolerance: float = Field(
+        0.0, ge=0, le=1, exclude_if=lambda v: v == 0.0, json_schema_extra={"unit": "1"},
+        description="flat_joint only: grains whose gap lies between gap_tolerance and this fraction of the smaller "
+        "radius get a gapped face (Potyondy 2012's installation gap): unbonded, it carries nothing until the grains "
+        "touch, then compression, friction and rocking like a broken face (instead of the Hertz contact). 0: none. "
+        "Written to spec.json only when not 0.",
+    )
     face_rings: int = Field(
         1, ge=1, le=4, exclude_if=lambda v: v == 1, json_schema_extra={"unit": "1"},
         description="flat_joint with face_sectors > 1: rings of elements on the face (equal widths). Written to "
@@ -212,6 +219,9 @@ class Bonds(_Model):
                 if value != plain:
                     raise ValueError(f"{field}: not available with model: flat_joint, whose bonds all share one law "
                                      f"(fix: {field}: {plain:g}, or model: bpm_rotational)")
+            if 0 < self.face_gap_tolerance <= self.gap_tolerance:
+                raise ValueError(f"face_gap_tolerance: {self.face_gap_tolerance:g} is not above gap_tolerance "
+                                 f"{self.gap_tolerance:g}, so no pair gets a gapped face (fix: a larger value, or 0)")
             if self.face_sectors == 2:
                 raise ValueError("face_sectors: 2 halves give a face that bends more easily one way than the other "
                                  "(fix: 1 for one element, or 3-16)")
@@ -224,7 +234,8 @@ class Bonds(_Model):
         else:
             for field, value, plain in (("joint_friction", self.joint_friction, 0.5),
                                         ("moment_contribution", self.moment_contribution, 1.0),
-                                        ("face_sectors", self.face_sectors, 1), ("face_rings", self.face_rings, 1)):
+                                        ("face_sectors", self.face_sectors, 1), ("face_rings", self.face_rings, 1),
+                                        ("face_gap_tolerance", self.face_gap_tolerance, 0.0)):
                 if value != plain:
                     raise ValueError(f"{field}: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
         return self

@@ -48,9 +48,11 @@
 
    Syntax:  bond_style deckgen/flatjoint FILE          (FILE: broken bonds, one line each, appended)
             bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings]]
-            (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1; sectors 1 (one element, the law above) or 3-16; rings 1-4)
+            (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1/2; sectors 1 (one element, the law above) or 3-16; rings 1-4)
    A bond type with slit 1 holds faces that are broken from the start: closed, cohesionless contacts with the
    broken face's law (the slit elements of Potyondy's flat joint); they are neither counted nor listed as breaks.
+   Slit 2: gapped faces, also unbonded from the start but with the reference length r0 = r_i + r_j (the grains
+   touching), so they carry nothing until the gap closes (the installation gap of Potyondy's flat joint).
    Serial only (one MPI rank): bond states live in this object, keyed by atom tags.
 */
 
@@ -182,7 +184,8 @@ class BondFlatJoint : public Bond {
     double v[NCOEFF] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1};
     for (int k = 0; k < narg - 1; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
     if (v[7] < 0.0 || v[7] > 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: beta must be in [0, 1]");
-    if (v[8] != 0.0 && v[8] != 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 or 1");
+    if (v[8] != 0.0 && v[8] != 1.0 && v[8] != 2.0)
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 (bonded), 1 (slit) or 2 (gapped)");
     if (v[9] != std::floor(v[9]) || v[10] != std::floor(v[10]) || !(v[9] == 1.0 || (v[9] >= 3.0 && v[9] <= 16.0)) ||
         v[10] < 1.0 || v[10] > 4.0 || (v[9] == 1.0 && v[10] != 1.0))
       error->all(FLERR, "bond_coeff for deckgen/flatjoint: sectors 1 (one element) or 3-16, rings 1-4 (1 with one sector)");
@@ -304,7 +307,7 @@ class BondFlatJoint : public Bond {
     b.type = type;
     b.broken = coeffs[type][8] > 0.0;    // slit: broken from the start
     double d[3] = {atom->x[j][0] - atom->x[i][0], atom->x[j][1] - atom->x[i][1], atom->x[j][2] - atom->x[i][2]};
-    b.r0 = norm3(d);
+    b.r0 = coeffs[type][8] == 2.0 ? atom->radius[i] + atom->radius[j] : norm3(d);    // gapped: touching
     const double *c = coeffs[type];
     b.rb = c[2] * std::fmin(atom->radius[i], atom->radius[j]);
     b.area = M_PI * b.rb * b.rb;
@@ -317,7 +320,8 @@ class BondFlatJoint : public Bond {
     b.kb = kn_area * b.inertia;
     const int sectors = static_cast<int>(c[9]), rings = static_cast<int>(c[10]);
     if (sectors > 1) {
-      const double n[3] = {d[0] / b.r0, d[1] / b.r0, d[2] / b.r0};
+      const double dist = norm3(d);
+      const double n[3] = {d[0] / dist, d[1] / dist, d[2] / dist};
       // any in-plane start vector: the axis least aligned with n, made normal to n
       double a[3] = {0.0, 0.0, 0.0};
       int kmin = 0;

@@ -40,6 +40,31 @@ K_N = E_B / (2 * R) * AREA  # N/m
 DT, STEP = 1e-7, 1e-9  # s; platen-like motion of grain 2 per step [m]
 
 
+def _deck_head(lib: Path, x2: tuple[float, float, float], coeffs: str) -> str:
+    """Grain 1 at the origin, grain 2 at ``x2``, bonded with ``bond_coeff 1 <coeffs>``; groups g1, g2; dt DT."""
+    return f"""plugin load {lib}
+units si
+atom_style bpm/sphere
+special_bonds lj 0 1 1 coul 1 1 1
+newton on off
+comm_modify vel yes
+region b block -0.01 0.01 -0.01 0.01 -0.01 0.01
+create_box 1 b bond/types 1 extra/bond/per/atom 2 extra/special/per/atom 2
+create_atoms 1 single 0.0 0.0 0.0
+create_atoms 1 single {x2[0]:.12g} {x2[1]:.12g} {x2[2]:.12g}
+set type 1 diameter {2 * R:.10g}
+set type 1 density {RHO:.10g}
+pair_style granular
+pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
+bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
+bond_coeff 1 {coeffs}
+create_bonds single/bond 1 1 2
+group g1 id 1
+group g2 id 2
+timestep {DT:.10g}
+"""
+
+
 def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 1.0,
                 spin_period_s: float = 0.0, sectors: int = 1, gap: float = 0.0, slit: int = 0) -> np.ndarray:
     """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs (or, with ``spin_period_s``, turned about its own
@@ -52,26 +77,8 @@ def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 
                          for _, _, n in moves)
     else:
         legs = "\n".join(f"fix m g2 move linear {vx:.10g} {vy:.10g} 0\nrun {n}\nunfix m" for vx, vy, n in moves)
-    (tmp / "in.two").write_text(f"""plugin load {lib}
-units si
-atom_style bpm/sphere
-special_bonds lj 0 1 1 coul 1 1 1
-newton on off
-comm_modify vel yes
-region b block -0.01 0.01 -0.01 0.01 -0.01 0.01
-create_box 1 b bond/types 1 extra/bond/per/atom 2 extra/special/per/atom 2
-create_atoms 1 single 0.0 0.0 0.0
-create_atoms 1 single {2 * R + gap:.10g} 0.0 0.0
-set type 1 diameter {2 * R:.10g}
-set type 1 density {RHO:.10g}
-pair_style granular
-pair_coeff * * hertz/material 1e9 0.5 0.25 tangential linear_nohistory 1.0 0.0
-bond_style deckgen/flatjoint {FLAT_JOINT_BROKEN}
-bond_coeff 1 {E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {beta:.10g}{elements}
-create_bonds single/bond 1 1 2
-group g2 id 2
-timestep {DT:.10g}
-variable fx2 equal fx[2]
+    coeffs = f"{E_B:.10g} {KAPPA:.10g} {LAM:.10g} {SIGMA_C:.10g} {COH:.10g} {MU:.10g} 0.0 {beta:.10g}{elements}"
+    (tmp / "in.two").write_text(_deck_head(lib, (2 * R + gap, 0.0, 0.0), coeffs) + f"""variable fx2 equal fx[2]
 variable fy2 equal fy[2]
 thermo 100000
 fix out all print 1 "$(step) ${{fx2}} ${{fy2}}" file forces.txt screen no
@@ -178,6 +185,31 @@ def test_a_gapped_face_carries_nothing_until_the_grains_touch(tmp_path):
     assert not _breaks(tmp_path)  # a gapped face is never a break
 
 
+@needs_engine
+def test_a_face_of_elements_loads_the_grains_as_the_one_element_face_while_elastic(tmp_path):
+    """Grains on a diagonal, grain 2 turned about its own centre and a skew axis (shear, bending and twist at
+    once), strengths out of reach: the element face's force and torques equal the one-element face's (a first
+    version applied its shear at a wrong arm off the x axis: a negative Poisson's ratio in the UCS tests)."""
+    lib = plugins.install(tmp_path, "flatjoint")
+    d = 2 * R / math.sqrt(3.0)
+    rows = {}
+    for sectors in (1, 4):
+        elements = f" 0 {sectors} 1" if sectors > 1 else ""
+        coeffs = f"{E_B:.10g} {KAPPA:.10g} {LAM:.10g} 1e12 1e12 {MU:.10g} 0.0 1.0{elements}"
+        (tmp_path / "in.skew").write_text(_deck_head(lib, (d, d, d), coeffs) + f"""fix f1 g1 move linear 0 0 0
+fix m g2 move rotate {d:.12g} {d:.12g} {d:.12g} 0.3 -0.5 0.8 0.01
+dump d all custom 100 dump.txt id fx fy fz tqx tqy tqz
+dump_modify d format float %.10e
+run 100
+""")
+        proc = subprocess.run(engine_command(1) + ["-in", "in.skew", "-log", "none"], cwd=tmp_path, env=engine_env(),
+                              capture_output=True, text=True, timeout=300)
+        assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+        rows[sectors] = np.loadtxt((tmp_path / "dump.txt").read_text().splitlines()[-2:])[:, 1:]
+    assert np.abs(rows[1][:, 3:]).max() > 1e-3  # N m: the torques are real
+    assert rows[4] == pytest.approx(rows[1], rel=1e-5, abs=1e-9)
+
+
 def test_flat_joint_validation_names_field_and_fix():
     case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
     assert resolved_dict(case)["bonds"]["model"] == "flat_joint"
@@ -217,6 +249,20 @@ def test_micro_params_keep_their_keys_and_map_the_flat_joint():
     e = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0, flat_joint=1,
                     face_sectors=4)
     assert e.key() != q.key() and e.overrides()["bonds"]["face_sectors"] == 4
+
+
+def test_flat_joint_start_table_returns_a_measured_point_for_its_own_macro_values():
+    from deckgen.calibrate import MICRO_MACRO_FLAT_JOINT, CardTargets, ParameterSpace, analytic_start, prior_jacobian
+
+    sp = ParameterSpace(["log_E_b", "log_sigma_c", "log_tau_ratio"], bounds={"log_tau_ratio": (0.0, 4.6)})
+    sigma_c, c, E, ucs, bts = MICRO_MACRO_FLAT_JOINT[3]  # c/sigma_c 16 at c 120 MPa: UCS/BTS 11.9
+    t = CardTargets(density_kg_m3=2450, ucs_MPa=ucs, bts_MPa=bts, youngs_modulus_GPa=E, poisson_ratio=0.2,
+                    citation="table row")
+    p = analytic_start(t, None, sp, table="flat_joint")
+    assert (p.youngs_modulus_GPa, p.tensile_strength_MPa, p.shear_strength_MPa) == pytest.approx((20.0, sigma_c, c), rel=1e-6)
+    assert p.flat_joint == 1 and p.moment_contribution == 0.0 and p.gap_tolerance == 0.4
+    J = prior_jacobian(sp, "flat_joint")  # rows UCS, BTS, E; columns E_b, sigma_c, c/sigma_c
+    assert J[2, 0] > 0.8 and J[1, 1] > 0.8 and J[0, 2] > J[1, 2] > 0  # c/sigma_c raises UCS more than BTS
 
 
 @pytest.mark.skipif(not have_compiler, reason="no C++ compiler for the plugin (apt-get install g++)")

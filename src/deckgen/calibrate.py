@@ -131,11 +131,13 @@ class CalibrationSetup(_Model):
     ucs_packings: int = Field(1, ge=1, le=10, description="UCS tests per evaluation (packing seeds), averaged.")
     bts_packings: int = Field(3, ge=1, le=10, description=(
         "BTS tests per evaluation (packing seeds), averaged: a coarse Brazilian disc scatters ~12 % over packings."))
-    start_table: Literal["ratio", "high_strain"] = Field(
+    start_table: Literal["ratio", "high_strain", "flat_joint"] = Field(
         "ratio", description=(
             "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
             "strain sigma_c/E_b 0.75e-3; UCS/BTS from the interaction range g) or 'high_strain' (sigma_c/E_b 3e-3 to "
-            "6e-3 at g 0.4 and E_c/E_b 4; UCS/BTS from a low tau_c/sigma_c), for rocks with UCS/E above ~0.5 %."))
+            "6e-3 at g 0.4 and E_c/E_b 4; UCS/BTS from a low tau_c/sigma_c), for rocks with UCS/E above ~0.5 %; "
+            "'flat_joint' (bonds.model flat_joint with beta 0, g 0.4, E_c/E_b 4: UCS/BTS from a high c/sigma_c; the "
+            "start sets flat_joint and moment_contribution 0)."))
     bounds: dict[ParamName, tuple[float, float]] = Field(
         default_factory=dict, description=(
             "Bounds of optimiser parameters in the optimiser's units (log of the physical value for log_*), "
@@ -520,6 +522,24 @@ MICRO_MACRO_HIGH_STRAIN: tuple[tuple[float, float, float, float, float], ...] = 
 HIGH_STRAIN_GAP, HIGH_STRAIN_CONTACT_RATIO = 0.4, 4.0
 
 
+#: Measured with the flat joint (``bonds.model: flat_joint``, moment contribution beta 0, joint friction 0.5; ``python
+#: -m deckgen.calibration_studies ratio --set flat-joint --card cases/materials/sandstone.yaml --bts-packings 3
+#: --bts-stop 0.2``; docs/calibration_runs/ratio_flat_joint.csv): E_b 20 GPa, g 0.4, contact modulus 4 E_b,
+#: sandstone density and platen speeds, coarse grains, BTS the mean of three discs. Rows: (sigma_c MPa, c MPa,
+#: E GPa, UCS MPa, BTS MPa). UCS/BTS rises with c/sigma_c: 5.8, 8.3, 8.3, 11.9, 14.6 at 2, 4, 8, 16, 32 (c 120
+#: MPa); at c/sigma_c 2 it hardly moves with the strengths (5.8, 6.5, 6.6 at c 120, 60, 30 MPa).
+MICRO_MACRO_FLAT_JOINT: tuple[tuple[float, float, float, float, float], ...] = (
+    (60.0, 120.0, 14.69, 321.8, 55.20),
+    (30.0, 120.0, 14.20, 286.6, 34.50),
+    (15.0, 120.0, 12.65, 231.9, 28.11),
+    (7.5, 120.0, 11.93, 209.5, 17.56),
+    (3.75, 120.0, 11.07, 187.9, 12.84),
+    (30.0, 60.0, 13.95, 167.8, 25.76),
+    (15.0, 30.0, 13.07, 85.25, 12.94),
+)
+FLAT_JOINT_E_B_GPA = 20.0
+
+
 def _loglin(values: list[float], at: list[float], x: float) -> float:
     """Linear inter/extrapolation of log(values) over ``at`` (two or more points) at ``x``."""
     lv = np.log(values)
@@ -558,6 +578,73 @@ def micro_macro_high_strain(strain: float, r: float) -> tuple[float, float, floa
         per_level.append([_loglin(list(sub[:, c]), list(np.log(sub[:, 1])), math.log(r)) for c in (2, 3, 4)])
     out = [_loglin([math.exp(v[c]) for v in per_level], list(np.log(levels)), math.log(strain)) for c in range(3)]
     return tuple(math.exp(v) for v in out)  # type: ignore[return-value]
+
+
+def micro_macro_flat_joint(s: float, r: float) -> tuple[float, float, float]:
+    """(E/E_b, UCS/c, BTS/c) of :data:`MICRO_MACRO_FLAT_JOINT` at shear failure strain s = c/E_b and c/sigma_c
+    ``r``: log-linear in log r at c/E_b 6e-3 plus the change in log s at c/sigma_c 2 (no cross term measured;
+    extrapolated outside the measured ranges)."""
+    rows = np.array(MICRO_MACRO_FLAT_JOINT)
+    r_all, s_all = rows[:, 1] / rows[:, 0], rows[:, 1] / (FLAT_JOINT_E_B_GPA * 1e3)
+    vals = np.column_stack([rows[:, 2] / FLAT_JOINT_E_B_GPA, rows[:, 3] / rows[:, 1], rows[:, 4] / rows[:, 1]])
+    s_ref = float(s_all.max())
+    at_r = np.isclose(s_all, s_ref)
+    at_s = np.isclose(r_all, 2.0)
+    order_r = np.argsort(r_all[at_r])
+    order_s = np.argsort(s_all[at_s])
+    out = []
+    for c in range(3):
+        lr = list(np.log(r_all[at_r][order_r]))
+        ls = list(np.log(s_all[at_s][order_s]))
+        f_r = _loglin(list(vals[at_r][order_r, c]), lr, math.log(r))
+        f_s = _loglin(list(vals[at_s][order_s, c]), ls, math.log(s))
+        f_s0 = _loglin(list(vals[at_s][order_s, c]), ls, math.log(s_ref))
+        out.append(math.exp(f_r + f_s - f_s0))
+    return tuple(out)  # type: ignore[return-value]
+
+
+def _flat_joint_macro(E_b: float, sigma_c: float, r: float) -> tuple[float, float, float]:
+    """(UCS MPa, BTS MPa, E GPa) of the flat-joint table at E_b [GPa], sigma_c [MPa], c/sigma_c r."""
+    c = sigma_c * r
+    cE, cU, cB = micro_macro_flat_joint(c / (E_b * 1e3), r)
+    return c * cU, c * cB, E_b * cE
+
+
+def _start_flat_joint(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroParams:
+    """Start from the flat-joint table (beta 0): c/sigma_c for UCS/BTS, c/E_b for UCS/E, then E_b for E (fixed
+    point, 50 sweeps; c/sigma_c within the bounds of ``log_tau_ratio`` when it is free)."""
+    from scipy.optimize import brentq
+
+    lo_r, hi_r = 1.0, 64.0
+    if "log_tau_ratio" in sp.names:
+        k = sp.names.index("log_tau_ratio")
+        lo_r, hi_r = math.exp(sp.lo[k]), math.exp(sp.hi[k])
+    want_ratio, want_ue = math.log(t.ucs_MPa / t.bts_MPa), math.log(t.ucs_MPa / (t.youngs_modulus_GPa * 1e3))
+    s, r = 6e-3, 8.0
+    for _ in range(50):
+        def fr(lr: float) -> float:
+            _, a, b = micro_macro_flat_joint(s, math.exp(lr))
+            return math.log(a / b) - want_ratio
+
+        a, b = math.log(lo_r), math.log(hi_r)
+        r = math.exp(brentq(fr, a, b, xtol=1e-10)) if fr(a) * fr(b) < 0 else math.exp(a if abs(fr(a)) < abs(fr(b)) else b)
+
+        def fs(ls: float) -> float:
+            cE, cU, _ = micro_macro_flat_joint(math.exp(ls), r)
+            return math.log(cU * math.exp(ls) / cE) - want_ue
+
+        new = math.exp(brentq(fs, math.log(1e-5), math.log(1e-1), xtol=1e-12))
+        if abs(math.log(new / s)) < 1e-10:
+            break
+        s = new
+    cE, _, _ = micro_macro_flat_joint(s, r)
+    E_b = t.youngs_modulus_GPa / cE
+    c = s * E_b * 1e3
+    return MicroParams(
+        youngs_modulus_GPa=E_b, tensile_strength_MPa=c / r, shear_strength_MPa=c,
+        friction=base.contact.friction, rolling_friction=base.contact.rolling_friction,
+        radius_multiplier=base.bonds.radius_multiplier, gap_tolerance=HIGH_STRAIN_GAP,
+        contact_modulus_ratio=HIGH_STRAIN_CONTACT_RATIO, flat_joint=1, moment_contribution=0.0)
 
 
 def _start_high_strain(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroParams:
@@ -609,6 +696,7 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
 
     ``table="high_strain"``: :func:`micro_macro_high_strain` instead (g 0.4 and E_c/E_b 4 as measured;
     tau_c/sigma_c sets UCS/BTS, within the bounds of ``log_tau_ratio`` when it is free).
+    ``table="flat_joint"``: :func:`micro_macro_flat_joint` (the flat joint with beta 0, g 0.4, E_c/E_b 4).
     """
     if base_case is None:
         base = Case()
@@ -618,8 +706,11 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         base = Case.model_validate(base_case)
     t = targets
     sp = space or ParameterSpace()
-    if table not in ("ratio", "high_strain"):
-        raise ValueError(f"analytic_start: unknown table {table!r} (fix: 'ratio' or 'high_strain')")
+    if table not in ("ratio", "high_strain", "flat_joint"):
+        raise ValueError(f"analytic_start: unknown table {table!r} (fix: 'ratio', 'high_strain' or 'flat_joint')")
+    if table == "flat_joint":  # only the optimiser's parameters are clipped (the flat joint refuses torque factors)
+        p = _start_flat_joint(t, base, sp)
+        return sp.from_vector(sp.clip_inside(sp.to_vector(p), 1e-3), p)
     if table == "high_strain":
         p = _start_high_strain(t, base, sp)
         bounds = {n: (float(lo), float(hi)) for n, lo, hi in zip(sp.names, sp.lo, sp.hi)}
@@ -682,12 +773,35 @@ def _prior_high_strain(space: ParameterSpace) -> np.ndarray:
     return base
 
 
+def _prior_flat_joint(space: ParameterSpace) -> np.ndarray:
+    """Prior Jacobian from :func:`_flat_joint_macro` by central differences at E_b 20 GPa, sigma_c 7.5 MPa,
+    c/sigma_c 16 (the middle of the table); the other columns as in the 'ratio' prior."""
+    base = prior_jacobian(space, "ratio")
+    x0 = np.log([FLAT_JOINT_E_B_GPA, 7.5, 16.0])
+    h = 0.1
+
+    def out(x: np.ndarray) -> np.ndarray:
+        return np.log(_flat_joint_macro(*np.exp(x)))
+
+    cols = {}
+    for k, name in enumerate(("log_E_b", "log_sigma_c", "log_tau_ratio")):
+        dx = np.zeros(3)
+        dx[k] = h
+        cols[name] = (out(x0 + dx) - out(x0 - dx)) / (2 * h)
+    for k, n in enumerate(space.names):
+        if n in cols:
+            base[:, k] = cols[n]
+    return base
+
+
 def prior_jacobian(space: ParameterSpace, table: str = "ratio") -> np.ndarray:
     """d log(UCS, BTS, E) / d x of the measured micro-macro table (rows: outputs; columns: parameters),
     as secants over the measured range (tau_c/sigma_c 0.5-2 at g = 0.05; g 0.05-0.4 at r = 1);
     ``table="high_strain"``: :func:`_prior_high_strain`."""
     if table == "high_strain":
         return _prior_high_strain(space)
+    if table == "flat_joint":
+        return _prior_flat_joint(space)
     (E1, U1, B1), (E2, U2, B2) = micro_macro(0.05, 0.5), micro_macro(0.05, 2.0)
     (Eg0, Ug0, Bg0), (Eg1, Ug1, Bg1) = micro_macro(0.05, 1.0), micro_macro(0.4, 1.0)  # the rising branch
     lr = math.log(4.0)
@@ -1065,7 +1179,8 @@ class _Stop(Exception):
 TABLE_COLUMNS = [
     "eval", "key", "ok", "error", "youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa", "friction",
     "rolling_friction", "radius_multiplier", "gap_tolerance", "contact_modulus_ratio", "clump_size",
-    *OPTIONAL_BOND_FIELDS, "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
+    *OPTIONAL_BOND_FIELDS, "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
+    "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
     "bts_error_1", "E_error_1", "ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1",
     "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]

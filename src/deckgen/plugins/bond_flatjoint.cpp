@@ -354,10 +354,10 @@ class BondFlatJoint : public Bond {
   bool interact(Joint &b, int i, int j)
   {
     if (!b.el.empty()) return interact_elements(b, i, j);
-    double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
-    const double *radius = atom->radius, *rmass = atom->rmass;
+    double **x = atom->x, **v = atom->v, **omega = atom->omega;
+    const double *radius = atom->radius;
     const double *c = coeffs[b.type];
-    const double mu = c[5], zeta = c[6], dt = update->dt;
+    const double mu = c[5], dt = update->dt;
 
     double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
     const double r = norm3(d);
@@ -425,7 +425,19 @@ class BondFlatJoint : public Bond {
       if (std::fabs(b.mt) > tmax) b.mt = std::copysign(tmax, b.mt);
     }
 
-    // damping of the relative motion (not stored)
+    apply(b, i, j, d, n, ri, rj, vn, vt, wt, wb, fn, b.fs, b.mt, b.mb);
+    return breaks;
+  }
+
+  // Apply the joint's elastic loads on j -- normal force fn (tension positive) along -n, shear force fs in the
+  // face, twisting moment mt about n and bending moment mb -- plus viscous damping of the relative motion
+  // (zeta of critical, not stored) to j and, opposite, to i; the shear acts at the face point.
+  void apply(const Joint &b, int i, int j, const double *d, const double *n, double ri, double rj, double vn,
+             const double *vt, double wt, const double *wb, double fn, const double *fs, double mt, const double *mb)
+  {
+    double **f = atom->f, **torque = atom->torque;
+    const double *radius = atom->radius, *rmass = atom->rmass;
+    const double zeta = coeffs[b.type][6];
     const double mstar = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
     const double Ii = 0.4 * rmass[i] * radius[i] * radius[i], Ij = 0.4 * rmass[j] * radius[j] * radius[j];
     const double istar = Ii * Ij / (Ii + Ij);
@@ -433,9 +445,9 @@ class BondFlatJoint : public Bond {
     const double gb = 2.0 * zeta * std::sqrt(istar * b.kb), gt = 2.0 * zeta * std::sqrt(istar * b.kt);
 
     double Fj[3], Ts[3], Mj[3];
-    for (int k = 0; k < 3; k++) Fj[k] = -(fn + gn * vn) * n[k] + b.fs[k] - gs * vt[k];
+    for (int k = 0; k < 3; k++) Fj[k] = -(fn + gn * vn) * n[k] + fs[k] - gs * vt[k];
     double shear_on_j[3] = {Fj[0] + (fn + gn * vn) * n[0], Fj[1] + (fn + gn * vn) * n[1], Fj[2] + (fn + gn * vn) * n[2]};
-    for (int k = 0; k < 3; k++) Mj[k] = (b.mt - gt * wt) * n[k] + b.mb[k] - gb * wb[k];
+    for (int k = 0; k < 3; k++) Mj[k] = (mt - gt * wt) * n[k] + mb[k] - gb * wb[k];
 
     for (int k = 0; k < 3; k++) {
       f[j][k] += Fj[k];
@@ -451,16 +463,15 @@ class BondFlatJoint : public Bond {
       // force on i and the vector from j to i, as LAMMPS' bond tally expects
       ev_tally_xyz(i, j, atom->nlocal, force->newton_bond, 0.0, -Fj[0], -Fj[1], -Fj[2], -d[0], -d[1], -d[2]);
     }
-    return breaks;
   }
 
   // A face of several elements (sectors > 1): forces and torques on i and j; true when its last bonded element breaks.
   bool interact_elements(Joint &b, int i, int j)
   {
-    double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
-    const double *radius = atom->radius, *rmass = atom->rmass;
+    double **x = atom->x, **v = atom->v, **omega = atom->omega;
+    const double *radius = atom->radius;
     const double *c = coeffs[b.type];
-    const double sigma_c = c[3], coh = c[4], mu = c[5], zeta = c[6], dt = update->dt;
+    const double sigma_c = c[3], coh = c[4], mu = c[5], dt = update->dt;
     const double kn_area = b.kn / b.area, ks_area = b.ks / b.area;
 
     double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
@@ -561,29 +572,14 @@ class BondFlatJoint : public Bond {
       return breaks;
     }
 
-    // damping of the relative motion (not stored), while some element is bonded or closed
-    const double mstar = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
-    const double Ii = 0.4 * rmass[i] * radius[i] * radius[i], Ij = 0.4 * rmass[j] * radius[j] * radius[j];
-    const double istar = Ii * Ij / (Ii + Ij);
-    const double gn = 2.0 * zeta * std::sqrt(mstar * b.kn), gs = 2.0 * zeta * std::sqrt(mstar * b.ks);
-    const double gb = 2.0 * zeta * std::sqrt(istar * b.kb), gt = 2.0 * zeta * std::sqrt(istar * b.kt);
-    double Fj[3], Ts[3], Mj[3], shear_on_j[3];
+    // the sums as normal force, shear, twist and bending, damped while some element is bonded or closed
+    const double fn_sum = -dot3(ftot, n), mt_sum = dot3(mtot, n);
+    double fs_sum[3], mb_sum[3];
     for (int k = 0; k < 3; k++) {
-      Fj[k] = ftot[k] - gn * vn * n[k] - gs * vt[k];
-      shear_on_j[k] = Fj[k] - dot3(Fj, n) * n[k];
-      Mj[k] = mtot[k] - gt * wt * n[k] - gb * wb[k];
+      fs_sum[k] = ftot[k] + fn_sum * n[k];
+      mb_sum[k] = mtot[k] - mt_sum * n[k];
     }
-    for (int k = 0; k < 3; k++) {
-      f[j][k] += Fj[k];
-      f[i][k] -= Fj[k];
-    }
-    cross3(n, shear_on_j, Ts);
-    for (int k = 0; k < 3; k++) {
-      torque[j][k] += -rj * Ts[k] + Mj[k];
-      torque[i][k] += -ri * Ts[k] - Mj[k];
-    }
-    if (evflag)
-      ev_tally_xyz(i, j, atom->nlocal, force->newton_bond, 0.0, -Fj[0], -Fj[1], -Fj[2], -d[0], -d[1], -d[2]);
+    apply(b, i, j, d, n, ri, rj, vn, vt, wt, wb, fn_sum, fs_sum, mt_sum, mb_sum);
     return breaks;
   }
 };

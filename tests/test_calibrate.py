@@ -92,7 +92,7 @@ def test_card_round_trip_and_case_overrides(tmp_path):
     ({"calibration": {"bounds": {"log_tau_ratio": [-2.0, 0.5]}}}, "bounds: log_tau_ratio is not in parameters"),
     ({"calibration": {"parameters": ["log_E_b", "log_sigma_c", "log_tau_ratio"], "bounds": {"log_tau_ratio": [0.5, -2.0]}}},
      "bounds: log_tau_ratio: need finite lower < upper"),
-    ({"calibration": {"start_table": "medium"}}, "calibration.start_table: Input should be 'ratio' or 'high_strain'"),
+    ({"calibration": {"start_table": "medium"}}, "calibration.start_table: Input should be 'ratio', 'high_strain' or 'flat_joint'"),
     ({"calibrated": {"bonds": {"clump_size": 0}}}, "calibrated.bonds: clump_size"),
 ])
 def test_bad_card_field_gives_clear_error(tmp_path, patch, expect):
@@ -192,7 +192,7 @@ def test_clump_fields_in_params_keys_and_overrides():
     p = MicroParams(20.0, 60.0, 15.0, gap_tolerance=0.4, contact_modulus_ratio=4.0)
     # without clumps (and at the defaults of the later fields) the key is the one recorded before they existed
     later = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor", "strength_weibull_modulus",
-             "shrink_before_bonding", "flat_joint", "joint_friction", "moment_contribution")
+             "shrink_before_bonding", "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
     old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_") and k not in later}
     assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
     assert "clump_size" not in p.overrides()["bonds"]

@@ -265,6 +265,17 @@ def test_flat_joint_start_table_returns_a_measured_point_for_its_own_macro_value
     assert J[2, 0] > 0.8 and J[1, 1] > 0.8 and J[0, 2] > J[1, 2] > 0  # c/sigma_c raises UCS more than BTS
 
 
+def test_a_calibrated_card_keeps_the_bond_model_token_and_refuses_others():
+    from deckgen.calibrate import CalibratedParams
+
+    q = MicroParams(youngs_modulus_GPa=2.76, tensile_strength_MPa=1.12, shear_strength_MPa=13.15, flat_joint=1,
+                    moment_contribution=0.0)
+    c = CalibratedParams(bonds=q.overrides()["bonds"], contact=q.overrides()["contact"])
+    assert c.bonds["model"] == "flat_joint" and c.bonds["moment_contribution"] == 0.0
+    with pytest.raises(ValueError, match="model"):
+        CalibratedParams(bonds={**q.overrides()["bonds"], "model": "flat_joint; shell rm -rf /"})
+
+
 @pytest.mark.skipif(not have_compiler, reason="no C++ compiler for the plugin (apt-get install g++)")
 def test_deck_loads_the_plugin_from_the_run_folder_with_si_coefficients(tmp_path):
     case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "joint_friction": 0.7}})

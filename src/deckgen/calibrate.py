@@ -185,12 +185,13 @@ class CalibrationSetup(_Model):
 class CalibratedParams(_Model):
     """The calibrated micro-parameters as case overrides (``bonds.*``, ``contact.*``)."""
 
-    bonds: dict[str, float] = Field(default_factory=dict, description="Overrides of the case's bonds block.")
+    bonds: dict[str, float | str] = Field(default_factory=dict, description=(
+        "Overrides of the case's bonds block (numbers; 'model' is a token the bonds schema checks)."))
     contact: dict[str, float] = Field(default_factory=dict, description="Overrides of the case's contact block.")
 
     @field_validator("bonds")
     @classmethod
-    def _bonds(cls, v: dict[str, float]) -> dict[str, float]:
+    def _bonds(cls, v: dict[str, float | str]) -> dict[str, float | str]:
         _check_block(Bonds, "bonds", v)
         return v
 
@@ -1392,7 +1393,8 @@ def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, sp
     achieved = Achieved()
     if best is not None:
         ov = best.params.overrides(card.calibration.tie_contact_modulus)
-        calibrated = CalibratedParams(bonds={k: float(f"{v:.6g}") for k, v in ov["bonds"].items()},
+        calibrated = CalibratedParams(bonds={k: (v if isinstance(v, str) else float(f"{v:.6g}"))
+                                             for k, v in ov["bonds"].items()},
                                       contact={k: float(f"{v:.6g}") for k, v in ov["contact"].items()})
         e = res.errors
         achieved = Achieved(ucs_MPa=round(best.ucs_Pa / MPA, 4), bts_MPa=round(best.bts_Pa / MPA, 4),

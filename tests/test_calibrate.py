@@ -29,6 +29,7 @@ from deckgen.calibrate import (
 
 ROOT = Path(__file__).resolve().parents[1]
 MATERIALS = ROOT / "cases" / "materials"
+CONCRETE_BPM = ROOT / "tests" / "data" / "cards" / "concrete_bpm.yaml"  # a bpm/rotational card for the stand-in runs
 ROCKS = ["savonniere_limestone", "concrete", "sandstone", "colorado_red_granite"]
 
 
@@ -98,7 +99,7 @@ def test_card_round_trip_and_case_overrides(tmp_path):
 def test_bad_card_field_gives_clear_error(tmp_path, patch, expect):
     from deckgen.spec import deep_merge
 
-    data = deep_merge(yaml.safe_load((MATERIALS / "concrete.yaml").read_text()), patch)
+    data = deep_merge(yaml.safe_load((CONCRETE_BPM).read_text()), patch)
     p = tmp_path / "concrete.yaml"
     p.write_text(yaml.safe_dump(data))
     with pytest.raises(CardError) as exc:
@@ -364,12 +365,12 @@ def test_budget_stops_and_writes_unconverged_card(tmp_path):
 
 def test_cli_with_stand_in(tmp_path, capsys):
     out = tmp_path / "out"
-    assert main([str(MATERIALS / "concrete.yaml"), "--out", str(out), "--stand-in"]) == 0
+    assert main([str(CONCRETE_BPM), "--out", str(out), "--stand-in"]) == 0
     card = load_card(out / "card.yaml")
     assert card.provenance.converged and card.provenance.evaluator == "StandInEvaluator"
     assert "converged" in capsys.readouterr().out
     # resumable: a second call replays the table
-    assert main([str(MATERIALS / "concrete.yaml"), "--out", str(out), "--stand-in"]) == 0
+    assert main([str(CONCRETE_BPM), "--out", str(out), "--stand-in"]) == 0
     assert load_card(out / "card.yaml").provenance.new_evaluations == 0
 
 
@@ -380,7 +381,7 @@ def test_card_start_fixes_a_mechanism_the_tables_do_not_cover(tmp_path):
 
     from deckgen.calibrate import run_card
 
-    d = yaml.safe_load((MATERIALS / "concrete.yaml").read_text())
+    d = yaml.safe_load((CONCRETE_BPM).read_text())
     d.setdefault("calibration", {})["start"] = {"clump_size": 16, "twisting_strength_factor": 10.0,
                                                 "tensile_strength_MPa": 7.0}
     path = tmp_path / "c.yaml"
@@ -389,7 +390,7 @@ def test_card_start_fixes_a_mechanism_the_tables_do_not_cover(tmp_path):
     card = load_card(tmp_path / "out" / "card.yaml")
     assert card.calibrated.bonds["clump_size"] == 16 and card.calibrated.bonds["twisting_strength_factor"] == 10.0
     assert card.provenance.start["clump_size"] == 16 and card.provenance.start["tensile_strength_MPa"] == 7.0
-    plain = run_card(MATERIALS / "concrete.yaml", tmp_path / "plain", stand_in=True, quiet=True)
+    plain = run_card(CONCRETE_BPM, tmp_path / "plain", stand_in=True, quiet=True)
     r0 = plain.card.provenance.start["shear_strength_MPa"] / plain.card.provenance.start["tensile_strength_MPa"]
     assert card.provenance.start["shear_strength_MPa"] == pytest.approx(7.0 * r0, rel=1e-5)
     assert res.n_evals >= 1
@@ -472,3 +473,21 @@ def test_specimen_that_did_not_fail_is_run_longer_or_fails_the_point(tmp_path):
     assert 0.0025 < long["strain_at_peak_1"] < 0.005
     # the longer run's peak is the strength, above the cut run's lower bound
     assert out["ucs_Pa"] == pytest.approx(long["peak_stress_Pa"]) and out["ucs_Pa"] > cut["peak_stress_Pa"]
+
+
+def test_results_table_names_the_bond_law_and_the_seed_scatter():
+    """The issue-#3 table from the committed concrete card and its committed seed and speed studies."""
+    import pandas as pd
+
+    from deckgen.calibration_studies import results_table, scatter
+
+    runs = ROOT / "docs" / "calibration_runs"
+    text = results_table([MATERIALS / "concrete.yaml", MATERIALS / "savonniere_limestone.yaml"], runs)
+    concrete = next(ln for ln in text.splitlines() if ln.startswith("| concrete |"))
+    limestone = next(ln for ln in text.splitlines() if ln.startswith("| savonniere_limestone |"))
+    assert "| flat joint, β 0 |" in concrete and "| bpm/rotational |" in limestone
+    s = scatter(pd.read_csv(runs / "seeds_concrete.csv"))
+    card = _card("concrete")
+    assert f"{s['bts_Pa_mean'] / (card.targets.bts_MPa * 1e6) - 1:+.1%}" in concrete
+    q = pd.read_csv(runs / "quasistatic_concrete.csv")
+    assert f"{q['bts_change_at_half_speed_1'].iloc[1]:+.1%}" in concrete

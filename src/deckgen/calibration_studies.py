@@ -441,12 +441,22 @@ def scatter(df: pd.DataFrame) -> dict[str, float]:
     return out
 
 
+def _bond_law(bonds: dict[str, Any]) -> str:
+    """Short name of a calibrated bonds block's law, e.g. 'flat joint, β 0' or 'bpm/rotational'."""
+    if bonds.get("model") != "flat_joint":
+        return "bpm/rotational"
+    extra = [f"β {bonds['moment_contribution']:g}"] if "moment_contribution" in bonds else []
+    if bonds.get("joint_friction", 0.5) != 0.5:
+        extra.append(f"μ {bonds['joint_friction']:g}")
+    return ", ".join(["flat joint", *extra])
+
+
 def results_table(cards: list[Path], studies: Path) -> str:
     """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
     head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
-            "| E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) | new-seed mean vs target "
-            "| half speed: ΔUCS, ΔBTS |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+            "| bond law | E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) "
+            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for path in cards:
         try:
@@ -456,7 +466,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             continue
         p = card.provenance
         if p is None or card.calibrated is None:
-            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | |")
+            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | | |")
             continue
         a, b = p.achieved, card.calibrated.bonds
         nu = "–"
@@ -483,7 +493,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             f"| {card.rock} | {a.ucs_MPa:.4g} ({a.ucs_error:+.1%}) | {a.bts_MPa:.4g} ({a.bts_error:+.1%}) | "
             f"{a.youngs_modulus_GPa:.4g} ({a.youngs_modulus_error:+.1%}) | {nu} | {a.ucs_MPa / a.bts_MPa:.3g} | "
             f"{p.evaluations}{'' if p.converged else ' (not converged)'} | {p.wall_s / 60:.1f} | "
-            f"{b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
+            f"{_bond_law(b)} | {b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
             f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {b.get('gap_tolerance', 0.05):.3g} | "
             f"{card.calibrated.contact.get('youngs_modulus_GPa', b['youngs_modulus_GPa']) / b['youngs_modulus_GPa']:.3g} | "
             f"{seeds} | {seed_err} | {qs} |")
@@ -524,7 +534,8 @@ def main(argv: list[str] | None = None) -> int:
             base = ucs = bts = None
             if a.card:
                 card = load_card(a.card)
-                base = card.case_overrides()
+                # the card's targets, base and specimens, not its calibrated point (the variants set the bonds)
+                base = card.model_copy(update={"calibrated": None}).case_overrides()
                 ucs, bts = quasi_static_specimens(card)
             only = [o for o in a.only if o.strip()] if a.only else None  # an empty prefix would match all
             ucs = ucs or {**DEFAULT_UCS, "platen_speed_m_s": 0.1}

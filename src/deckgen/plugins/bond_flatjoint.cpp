@@ -104,6 +104,15 @@ struct Element {
   double fs[3];             // shear force on j [N]
 };
 
+// Relative motion of grain j to grain i at their face, computed once per joint and step.
+struct Motion {
+  double d[3], r, n[3];      // centre line i -> j, its length, its direction
+  double ri, rj;             // distances of the face point from the centres (in the ratio of the radii)
+  double vn, vt[3];          // normal rate, tangential slip velocity at the face point
+  double wt, wb[3];          // relative twist rate about n, relative bending rate (in the face plane)
+  double wmean[3];           // the grains' mean angular velocity
+};
+
 struct Joint {
   tagint tag_i, tag_j;
   int type;
@@ -354,16 +363,12 @@ class BondFlatJoint : public Bond {
   bool interact(Joint &b, int i, int j)
   {
     if (!b.el.empty()) return interact_elements(b, i, j);
-    double **x = atom->x, **v = atom->v, **omega = atom->omega;
-    const double *radius = atom->radius;
     const double *c = coeffs[b.type];
     const double mu = c[5], dt = update->dt;
-
-    double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
-    const double r = norm3(d);
-    if (r <= 0.0) error->one(FLERR, "bond_style deckgen/flatjoint: two bonded grains at one point");
-    const double n[3] = {d[0] / r, d[1] / r, d[2] / r};
-    double fn = b.kn * (r - b.r0);    // tension positive
+    Motion m;
+    relative_motion(i, j, m);
+    const double *n = m.n, *vt = m.vt, *wb = m.wb;
+    double fn = b.kn * (m.r - b.r0);    // tension positive
 
     if (b.broken && fn >= 0.0) {    // open face: no load, nothing remembered
       for (int k = 0; k < 3; k++) b.fs[k] = b.mb[k] = 0.0;
@@ -371,26 +376,13 @@ class BondFlatJoint : public Bond {
       return false;
     }
 
-    // the face point divides the centre line in the ratio of the radii
-    const double ri = r * radius[i] / (radius[i] + radius[j]), rj = r - ri;
-    double wi[3], wj[3], vrel[3];
-    cross3(omega[i], n, wi);
-    cross3(omega[j], n, wj);
-    for (int k = 0; k < 3; k++) vrel[k] = v[j][k] - v[i][k] - ri * wi[k] - rj * wj[k];
-    const double vn = dot3(vrel, n);
-    double vt[3], wrel[3], wb[3];
-    for (int k = 0; k < 3; k++) vt[k] = vrel[k] - vn * n[k];
-    for (int k = 0; k < 3; k++) wrel[k] = omega[j][k] - omega[i][k];
-    const double wt = dot3(wrel, n);
-    for (int k = 0; k < 3; k++) wb[k] = wrel[k] - wt * n[k];
-
     to_plane(b.fs, n);
     to_plane(b.mb, n);
     for (int k = 0; k < 3; k++) {
       b.fs[k] -= b.ks * vt[k] * dt;
       b.mb[k] -= b.kb * wb[k] * dt;
     }
-    b.mt -= b.kt * wt * dt;
+    b.mt -= b.kt * m.wt * dt;
 
     bool breaks = false;
     if (!b.broken) {
@@ -403,13 +395,7 @@ class BondFlatJoint : public Bond {
       else if (tau >= tau_c) mode = 2;
       if (mode) {
         breaks = true;
-        b.broken = true;
-        if (mode == 1) n_tension += 1.0;
-        else n_shear += 1.0;
-        if (out)
-          fprintf(out, "%lld %lld %lld %d %.9e %.9e %.9e\n", static_cast<long long>(update->ntimestep),
-                  static_cast<long long>(b.tag_i), static_cast<long long>(b.tag_j), mode,
-                  0.5 * (x[i][0] + x[j][0]), 0.5 * (x[i][1] + x[j][1]), 0.5 * (x[i][2] + x[j][2]));
+        record_break(b, i, j, mode);
         if (fn >= 0.0) {
           for (int k = 0; k < 3; k++) b.fs[k] = b.mb[k] = 0.0;
           b.mt = 0.0;
@@ -425,16 +411,54 @@ class BondFlatJoint : public Bond {
       if (std::fabs(b.mt) > tmax) b.mt = std::copysign(tmax, b.mt);
     }
 
-    apply(b, i, j, d, n, ri, rj, vn, vt, wt, wb, fn, b.fs, b.mt, b.mb);
+    apply(b, i, j, m, fn, b.fs, b.mt, b.mb);
     return breaks;
+  }
+
+  // The relative motion of grains i and j at their face (fills m).
+  void relative_motion(int i, int j, Motion &m)
+  {
+    double **x = atom->x, **v = atom->v, **omega = atom->omega;
+    const double *radius = atom->radius;
+    for (int k = 0; k < 3; k++) m.d[k] = x[j][k] - x[i][k];
+    m.r = norm3(m.d);
+    if (m.r <= 0.0) error->one(FLERR, "bond_style deckgen/flatjoint: two bonded grains at one point");
+    for (int k = 0; k < 3; k++) m.n[k] = m.d[k] / m.r;
+    // the face point divides the centre line in the ratio of the radii
+    m.ri = m.r * radius[i] / (radius[i] + radius[j]);
+    m.rj = m.r - m.ri;
+    double wi[3], wj[3], vrel[3], wrel[3];
+    cross3(omega[i], m.n, wi);
+    cross3(omega[j], m.n, wj);
+    for (int k = 0; k < 3; k++) vrel[k] = v[j][k] - v[i][k] - m.ri * wi[k] - m.rj * wj[k];
+    m.vn = dot3(vrel, m.n);
+    for (int k = 0; k < 3; k++) m.vt[k] = vrel[k] - m.vn * m.n[k];
+    for (int k = 0; k < 3; k++) wrel[k] = omega[j][k] - omega[i][k];
+    m.wt = dot3(wrel, m.n);
+    for (int k = 0; k < 3; k++) m.wb[k] = wrel[k] - m.wt * m.n[k];
+    for (int k = 0; k < 3; k++) m.wmean[k] = 0.5 * (omega[i][k] + omega[j][k]);
+  }
+
+  // Joint b of grains i, j broke now in mode 1 (tension) or 2 (shear): counted and listed.
+  void record_break(Joint &b, int i, int j, int mode)
+  {
+    double **x = atom->x;
+    b.broken = true;
+    if (mode == 1) n_tension += 1.0;
+    else n_shear += 1.0;
+    if (out)
+      fprintf(out, "%lld %lld %lld %d %.9e %.9e %.9e\n", static_cast<long long>(update->ntimestep),
+              static_cast<long long>(b.tag_i), static_cast<long long>(b.tag_j), mode,
+              0.5 * (x[i][0] + x[j][0]), 0.5 * (x[i][1] + x[j][1]), 0.5 * (x[i][2] + x[j][2]));
   }
 
   // Apply the joint's elastic loads on j -- normal force fn (tension positive) along -n, shear force fs in the
   // face, twisting moment mt about n and bending moment mb -- plus viscous damping of the relative motion
   // (zeta of critical, not stored) to j and, opposite, to i; the shear acts at the face point.
-  void apply(const Joint &b, int i, int j, const double *d, const double *n, double ri, double rj, double vn,
-             const double *vt, double wt, const double *wb, double fn, const double *fs, double mt, const double *mb)
+  void apply(const Joint &b, int i, int j, const Motion &m, double fn, const double *fs, double mt, const double *mb)
   {
+    const double *d = m.d, *n = m.n, *vt = m.vt, *wb = m.wb;
+    const double ri = m.ri, rj = m.rj, vn = m.vn, wt = m.wt;
     double **f = atom->f, **torque = atom->torque;
     const double *radius = atom->radius, *rmass = atom->rmass;
     const double zeta = coeffs[b.type][6];
@@ -468,28 +492,14 @@ class BondFlatJoint : public Bond {
   // A face of several elements (sectors > 1): forces and torques on i and j; true when its last bonded element breaks.
   bool interact_elements(Joint &b, int i, int j)
   {
-    double **x = atom->x, **v = atom->v, **omega = atom->omega;
-    const double *radius = atom->radius;
     const double *c = coeffs[b.type];
     const double sigma_c = c[3], coh = c[4], mu = c[5], dt = update->dt;
     const double kn_area = b.kn / b.area, ks_area = b.ks / b.area;
-
-    double d[3] = {x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]};
-    const double r = norm3(d);
-    if (r <= 0.0) error->one(FLERR, "bond_style deckgen/flatjoint: two bonded grains at one point");
-    const double n[3] = {d[0] / r, d[1] / r, d[2] / r};
-    const double ri = r * radius[i] / (radius[i] + radius[j]), rj = r - ri;
-    double wi[3], wj[3], vrel[3];
-    cross3(omega[i], n, wi);
-    cross3(omega[j], n, wj);
-    for (int k = 0; k < 3; k++) vrel[k] = v[j][k] - v[i][k] - ri * wi[k] - rj * wj[k];
-    const double vn = dot3(vrel, n);
-    double vt[3], wrel[3], wb[3], wmean[3];
-    for (int k = 0; k < 3; k++) vt[k] = vrel[k] - vn * n[k];
-    for (int k = 0; k < 3; k++) wrel[k] = omega[j][k] - omega[i][k];
-    const double wt = dot3(wrel, n);
-    for (int k = 0; k < 3; k++) wb[k] = wrel[k] - wt * n[k];
-    for (int k = 0; k < 3; k++) wmean[k] = 0.5 * (omega[i][k] + omega[j][k]);
+    Motion m;
+    relative_motion(i, j, m);
+    const double *n = m.n, *vt = m.vt, *wb = m.wb, *wmean = m.wmean;
+    const double r = m.r, wt = m.wt;
+    const double wn[3] = {wt * n[0], wt * n[1], wt * n[2]};    // the twist rate as a vector
 
     // the face frame turns with the grains' mean rotation, then back into the plane normal to n
     double de[3];
@@ -525,7 +535,6 @@ class BondFlatJoint : public Bond {
         continue;
       }
       // slip of the element point: the face's tangential slip and the twist about n
-      const double wn[3] = {wt * n[0], wt * n[1], wt * n[2]};
       cross3(wn, p, tw);
       for (int k = 0; k < 3; k++) slip[k] = vt[k] + tw[k];
       to_plane(e.fs, n);
@@ -548,24 +557,18 @@ class BondFlatJoint : public Bond {
       if (!e.bonded) cap(e.fs, mu * (-fe));
       closed_any = closed_any || fe < 0.0;
       // on j: -fe n + fs at p (from the face centre)
-      double fj[3], m[3];
+      double fj[3], mom[3];
       for (int k = 0; k < 3; k++) fj[k] = -fe * n[k] + e.fs[k];
-      cross3(p, fj, m);
+      cross3(p, fj, mom);
       for (int k = 0; k < 3; k++) {
         ftot[k] += fj[k];
-        mtot[k] += m[k];
+        mtot[k] += mom[k];
       }
     }
     bool breaks = false;
     if (!b.broken && b.nbonded == 0) {
       breaks = true;
-      b.broken = true;
-      if (mode_last == 1) n_tension += 1.0;
-      else n_shear += 1.0;
-      if (out)
-        fprintf(out, "%lld %lld %lld %d %.9e %.9e %.9e\n", static_cast<long long>(update->ntimestep),
-                static_cast<long long>(b.tag_i), static_cast<long long>(b.tag_j), mode_last,
-                0.5 * (x[i][0] + x[j][0]), 0.5 * (x[i][1] + x[j][1]), 0.5 * (x[i][2] + x[j][2]));
+      record_break(b, i, j, mode_last);
     }
     if (b.broken && !closed_any) {    // an open broken face: no load, no bending remembered
       for (int k = 0; k < 3; k++) b.theta[k] = 0.0;
@@ -579,7 +582,7 @@ class BondFlatJoint : public Bond {
       fs_sum[k] = ftot[k] + fn_sum * n[k];
       mb_sum[k] = mtot[k] - mt_sum * n[k];
     }
-    apply(b, i, j, d, n, ri, rj, vn, vt, wt, wb, fn_sum, fs_sum, mt_sum, mb_sum);
+    apply(b, i, j, m, fn_sum, fs_sum, mt_sum, mb_sum);
     return breaks;
   }
 };

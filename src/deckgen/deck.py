@@ -459,6 +459,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
         strength_factor=strength, bins_strength=b.type_bins_strength)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
+    # flat joint: the slit and the gapped faces are bonds of one type each, after the bond table's types
+    slit_type = table.ntypes + 1 if len(slits) else None
+    gapped_type = table.ntypes + 1 + (1 if len(slits) else 0) if len(gapped) else None
     if len(slits) or len(gapped):  # slit and gapped faces are as stiff as bonds in compression: the time step counts them
         dt_info = stable_timestep(atoms.x, r, mass, make_bond_table(
             atoms.x, r, mass, np.concatenate([all_pairs, gapped]), E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
@@ -519,8 +522,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                   b.tensile_strength_MPa * MPA, b.shear_strength_MPa * MPA, b.joint_friction, b.damping_ratio,
                   b.moment_contribution]
         ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
-                             "slit_type": table.ntypes + 1 if len(slits) else None,
-                             "gapped_type": table.ntypes + 1 + (1 if len(slits) else 0) if len(gapped) else None,
+                             "slit_type": slit_type, "gapped_type": gapped_type,
                              "elements": [b.face_sectors, b.face_rings] if b.face_sectors > 1 else []}
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
@@ -723,10 +725,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
 
     write_bpm_data(out / DATA, title=f"deckgen {case.name}", box=box, types=types, radius=r_all, density=rho_all,
                    x=x_all, n_atom_types=n_atom_types, bonds=np.concatenate([table.pairs, slits, gapped]),
-                   bond_types=np.concatenate([table.types, np.full(len(slits), table.ntypes + 1, table.types.dtype),
-                                              np.full(len(gapped), table.ntypes + 1 + (1 if len(slits) else 0),
-                                                      table.types.dtype)]),
-                   n_bond_types=table.ntypes + (1 if len(slits) else 0) + (1 if len(gapped) else 0), extra_bond_per_atom=2)
+                   bond_types=np.concatenate([table.types, np.full(len(slits), slit_type or 0, table.types.dtype),
+                                              np.full(len(gapped), gapped_type or 0, table.types.dtype)]),
+                   n_bond_types=gapped_type or slit_type or table.ntypes, extra_bond_per_atom=2)
     ctx.update({"title": title, "template": template.split("/", 1)[1], "variables": variables})
     (out / DECK).write_text(render(template, ctx))
     spec = {"deckgen_version": __version__, "engine": "lammps", "case": resolved_dict(case), "derived": derived}

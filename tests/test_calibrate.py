@@ -48,10 +48,14 @@ def test_target_cards_match_rock_table():
     for rock in ROCKS:
         card = _card(rock)
         assert card.rock == rock
-        if card.provenance is not None:  # a calibrated card: it met its tolerance and says how
+        if card.provenance is not None:  # a calibrated card says whether it met its tolerance, and how
             a = card.provenance.achieved
-            assert card.provenance.converged and card.calibrated is not None
-            assert max(abs(a.ucs_error), abs(a.bts_error), abs(a.youngs_modulus_error)) <= card.provenance.tolerance
+            assert card.calibrated is not None
+            within = max(abs(a.ucs_error), abs(a.bts_error), abs(a.youngs_modulus_error)) <= card.provenance.tolerance
+            split = card.provenance.bts_max_broken_at_peak is None or a.bts_broken_at_peak <= card.provenance.bts_max_broken_at_peak
+            assert card.provenance.converged == (within and split), rock
+            if not card.provenance.converged:
+                assert "NOT converged" in (MATERIALS / f"{rock}.yaml").read_text()
             assert a.ucs_MPa == pytest.approx(card.targets.ucs_MPa * (1 + a.ucs_error), rel=1e-3)
         assert "seed 00" in card.targets.citation
         if rows:  # the shared rock table is there: the cards transcribe it
@@ -480,21 +484,28 @@ def test_specimen_that_did_not_fail_is_run_longer_or_fails_the_point(tmp_path):
     assert out["ucs_Pa"] == pytest.approx(long["peak_stress_Pa"]) and out["ucs_Pa"] > cut["peak_stress_Pa"]
 
 
-def test_results_table_names_the_bond_law_and_the_seed_scatter():
+def test_results_table_names_the_bond_law_and_the_seed_scatter(tmp_path):
     """The issue-#3 table from the committed concrete card and its committed seed and speed studies."""
     import pandas as pd
 
     from deckgen.calibration_studies import results_table, scatter
 
+    import shutil
+
     runs = ROOT / "docs" / "calibration_runs"
-    text = results_table([MATERIALS / "concrete.yaml", MATERIALS / "savonniere_limestone.yaml"], runs)
+    studies = tmp_path  # the session-13 concrete card (crushed discs) with its own seed and speed studies
+    for kind in ("seeds", "quasistatic"):
+        shutil.copy(runs / f"{kind}_concrete_crushed.csv", studies / f"{kind}_concrete.csv")
+    shutil.copy(runs / "seeds_savonniere_limestone.csv", studies)
+    text = results_table([runs / "concrete_flat_joint_crushed_card.yaml", MATERIALS / "savonniere_limestone.yaml"],
+                         studies)
     concrete = next(ln for ln in text.splitlines() if ln.startswith("| concrete |"))
     limestone = next(ln for ln in text.splitlines() if ln.startswith("| savonniere_limestone |"))
     assert "| flat joint, β 0 |" in concrete and "| bpm/rotational |" in limestone
-    s = scatter(pd.read_csv(runs / "seeds_concrete.csv"))
-    card = _card("concrete")
+    s = scatter(pd.read_csv(studies / "seeds_concrete.csv"))
+    card = load_card(runs / "concrete_flat_joint_crushed_card.yaml")
     assert f"{s['bts_Pa_mean'] / (card.targets.bts_MPa * 1e6) - 1:+.1%}" in concrete
-    q = pd.read_csv(runs / "quasistatic_concrete.csv")
+    q = pd.read_csv(studies / "quasistatic_concrete.csv")
     assert f"{q['bts_change_at_half_speed_1'].iloc[1]:+.1%}" in concrete
 
 
@@ -534,3 +545,16 @@ def test_split_check_passes_a_rock_whose_ratio_needs_no_crushing(tmp_path):
     res = calibrate(StandInEvaluator(noise=0.0, crush_ratio=10.0), card.targets, analytic_start(card.targets),
                     tmp_path / "t.csv", max_evals=30, bts_max_broken=0.2)
     assert res.converged and res.best.bts_broken < 0.2
+
+
+def test_a_calibrated_card_calibrates_on_its_setup_base_not_on_its_result():
+    """Re-running a calibrated card must find the runs its calibration recorded: same base, same setup key."""
+    from deckgen.calibrate import quasi_static_specimens, setup_base
+
+    card = _card("sandstone")
+    assert card.calibrated is not None
+    bare = card.model_copy(update={"calibrated": None})
+    assert setup_base(card) == bare.case_overrides() != card.case_overrides()
+    ucs, bts = quasi_static_specimens(card)
+    keys = {DemEvaluator(b, ucs, bts, "unused").setup_key for b in (setup_base(card), setup_base(bare))}
+    assert len(keys) == 1

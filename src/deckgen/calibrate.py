@@ -114,6 +114,10 @@ BTS_STRAIN_FACTOR = 8.0
 #: Largest mean fraction of a Brazilian disc's bonds broken at its peak for the peak to count as a split
 #: (docs/calibration.md, section "Split or crushed").
 BTS_MAX_BROKEN_AT_PEAK = 0.2
+#: Prior slope of the crushing penalty broken/limit - 1 in the optimiser's parameters, from the flat-joint rows of
+#: docs/calibration_runs/ratio_flat_joint.csv: log(broken at peak) rises ~0.9 per log(c/sigma_c) and falls ~0.15
+#: per log(sigma_c/E_b); times broken/limit ~2 of a crushed point. Other parameters: no prior (0).
+SPLIT_PRIOR = {"log_tau_ratio": 1.8, "log_sigma_c": -0.3, "log_E_b": 0.3}
 
 
 class CalibrationSetup(_Model):
@@ -877,7 +881,7 @@ class StandInEvaluator:
     r 0.5, so the real ratios 9-25 are reachable. Multiplicative log-normal noise of ``noise``
     (deterministic per parameter key, so replays agree). Failures: a deterministic share
     ``fail_rate`` of points, and every point with E_b > ``fail_above_E_b_GPa`` (like an unstable
-    time step). With ``crush_ratio`` it also reports the Brazilian discs' fraction of bonds broken at the peak,
+    time step). With ``crush_ratio`` (``measures_split``) it also reports the Brazilian discs' fraction of bonds broken at the peak,
     min(1, 0.1 (UCS/BTS / crush_ratio)^4): like the flat joint, the high ratios come with crushed discs.
     """
 
@@ -887,6 +891,7 @@ class StandInEvaluator:
                  seed: str = "0", crush_ratio: float | None = None) -> None:
         self.noise, self.fail_rate, self.fail_above = noise, fail_rate, fail_above_E_b_GPa
         self.crush_ratio = crush_ratio
+        self.measures_split = crush_ratio is not None
         self.seed = seed
         self.calls = 0
         self.keys: list[str] = []
@@ -980,6 +985,7 @@ class DemEvaluator:
         self.timeout_s = timeout_s
         self.name = name.replace("_", "-")
         self.engine_runs = 0  # engine runs started by this object (UCS + BTS; packings not counted)
+        self.measures_split = True  # results carry bts_broken_at_peak_1 (the split check of calibrate())
         # a test that reaches max_strain before failing is run again with EXTEND_FACTOR x the strain,
         # this many times, before the point counts as failed
         self.extend_attempts = extend_attempts
@@ -1187,8 +1193,9 @@ class Evaluation:
         return np.append(r, max(0.0, over))
 
     def split(self, max_broken: float | None) -> bool:
-        """The Brazilian discs split (their peaks are tensile strengths): within ``max_broken``, or not checked."""
-        return max_broken is None or not math.isfinite(self.bts_broken) or self.bts_broken <= max_broken
+        """The Brazilian discs split (their peaks are tensile strengths): within ``max_broken``, or not checked
+        (``max_broken`` None). An unknown fraction (NaN: the runs of a replayed point are gone) is no split."""
+        return max_broken is None or (math.isfinite(self.bts_broken) and self.bts_broken <= max_broken)
 
     def rel_errors(self, t: dict[str, float]) -> np.ndarray:
         if not self.ok:
@@ -1316,8 +1323,11 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
     table_path = Path(table_path)
     t = targets.as_pa()
     J0 = prior_jacobian(space) if prior is None else np.asarray(prior, dtype=float)
-    if bts_max_broken is not None:  # no prior for the crushing penalty: the recorded secants fill it
-        J0 = np.vstack([J0, np.zeros((1, J0.shape[1]))])
+    if bts_max_broken is not None and not getattr(evaluator, "measures_split", False):
+        log("split check off: the evaluator reports no fraction of bonds broken at the Brazilian peak")
+        bts_max_broken = None
+    if bts_max_broken is not None:  # the crushing penalty's prior row; the recorded secants refine it
+        J0 = np.vstack([J0, [[SPLIT_PRIOR.get(name, 0.0) for name in space.names]]])
     jac_est = _Jacobian(J0)
     mb = bts_max_broken
 
@@ -1464,7 +1474,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
 def _split_text(ev: Evaluation, max_broken: float | None) -> str:
     """Log text of the Brazilian discs' broken fraction at the peak and whether they split."""
     if not math.isfinite(ev.bts_broken):
-        return ""
+        return "" if max_broken is None else ", BTS discs: broken fraction at peak unknown (runs not on disk), no split"
     verdict = "" if max_broken is None else (" split" if ev.split(max_broken) else f" CRUSHED (> {max_broken:.0%})")
     return f", BTS discs {ev.bts_broken:.0%} broken at peak{verdict}"
 
@@ -1536,6 +1546,12 @@ def card_header(card: MaterialCard) -> str:
 
 
 # =============================================================================== CLI
+def setup_base(card: MaterialCard) -> dict[str, Any]:
+    """Base case overrides of a calibration: the setup's, not an earlier calibration's result, so a calibrated card
+    calibrates (and finds its recorded runs) as the targets-only card it came from."""
+    return card.model_copy(update={"calibrated": None}).case_overrides()
+
+
 def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None = None,
              command: list[str] | None = None, stand_in: bool = False, max_evals: int | None = None,
              tol: float | None = None, quiet: bool = False, parallel: bool = False) -> CalibrationResult:
@@ -1544,7 +1560,7 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
     out = Path(out)
     setup = card.calibration
     space = ParameterSpace(setup.parameters, bounds=dict(setup.bounds))
-    base = card.case_overrides()
+    base = setup_base(card)
     start = analytic_start(card.targets, deep_merge(base, {"specimen": setup.ucs_specimen}), space,
                            table=setup.start_table)
     if setup.start:

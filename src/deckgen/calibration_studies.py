@@ -152,6 +152,9 @@ HIGH_STRAIN_VARIANTS: list[tuple[str, dict[str, Any]]] = [
     ("c4 + twisting x3", {"twisting_strength_factor": 3.0, "clump_size": 4}),
     ("c4 + twisting x5", {"twisting_strength_factor": 5.0, "clump_size": 4}),
 ]
+#: The split base of the flat-joint set (beta 0, sigma_c 30, c 120 MPa: the highest UCS/BTS whose discs split)
+_SPLIT_BASE: dict[str, Any] = {"flat_joint": 1, "moment_contribution": 0.0, "tensile_strength_MPa": 30.0,
+                               "shear_strength_MPa": 120.0}
 #: The flat joint (bonds.model flat_joint, deckgen's plugin bond: tension and Mohr-Coulomb shear checked apart,
 #: a broken bond stays a frictional face that resists rocking) at the high-strain base point; the first row is
 #: the bpm/rotational base itself, measured beside it.
@@ -219,27 +222,15 @@ FLAT_JOINT_VARIANTS: list[tuple[str, dict[str, Any]]] = [
                                                   "moment_contribution": 0.0}),
     # split or crushed (docs/calibration.md): c/sigma above 4 at c 120 MPa crushed the discs (25-56 % of the bonds
     # broken at the peak); what raises UCS/BTS above 8.3 (c/sigma 4) while the discs still split?
-    ("split: beta 0, sigma_c 30, c 120, mu 1.0", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                  "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
-                                                  "joint_friction": 1.0}),
-    ("split: beta 0, sigma_c 20, c 120 (c/sigma 6)", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                      "tensile_strength_MPa": 20.0, "shear_strength_MPa": 120.0}),
-    ("split: beta 0, sigma_c 30, c 240 (c/sigma 8)", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                      "tensile_strength_MPa": 30.0, "shear_strength_MPa": 240.0}),
-    ("split: beta 0, sigma_c 30, c 120, slits 0.25", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                      "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
-                                                      "unbonded_fraction": 0.25}),
+    ("split: beta 0, sigma_c 30, c 120, mu 1.0", {**_SPLIT_BASE, "joint_friction": 1.0}),
+    ("split: beta 0, sigma_c 20, c 120 (c/sigma 6)", {**_SPLIT_BASE, "tensile_strength_MPa": 20.0}),
+    ("split: beta 0, sigma_c 30, c 240 (c/sigma 8)", {**_SPLIT_BASE, "shear_strength_MPa": 240.0}),
+    ("split: beta 0, sigma_c 30, c 120, slits 0.25", {**_SPLIT_BASE, "unbonded_fraction": 0.25}),
     # a stiffer shear spring (k_n/k_s 1) lowers the grains' lateral tension under compression (Poisson's ratio);
     # a stiffer Hertz contact and a longer interaction range add load paths in compression
-    ("split: beta 0, sigma_c 30, c 120, k_n/k_s 1", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                     "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
-                                                     "stiffness_ratio": 1.0}),
-    ("split: beta 0, sigma_c 30, c 120, E_c/E_b 8", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                     "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
-                                                     "contact_modulus_ratio": 8.0}),
-    ("split: beta 0, sigma_c 30, c 120, g 0.6", {"flat_joint": 1, "moment_contribution": 0.0,
-                                                 "tensile_strength_MPa": 30.0, "shear_strength_MPa": 120.0,
-                                                 "gap_tolerance": 0.6}),
+    ("split: beta 0, sigma_c 30, c 120, k_n/k_s 1", {**_SPLIT_BASE, "stiffness_ratio": 1.0}),
+    ("split: beta 0, sigma_c 30, c 120, E_c/E_b 8", {**_SPLIT_BASE, "contact_modulus_ratio": 8.0}),
+    ("split: beta 0, sigma_c 30, c 120, g 0.6", {**_SPLIT_BASE, "gap_tolerance": 0.6}),
 ]
 #: Variant sets of the ratio study: (base point, variants, output name).
 RATIO_SETS: dict[str, tuple[MicroParams, list[tuple[str, dict[str, Any]]], str]] = {
@@ -334,12 +325,11 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
         })
         row.update(_smoothed(ev, p, r["E_Pa"]))
         # split or crushed (docs/calibration.md, "Split or crushed"): the discs' bonds broken at their peaks
-        row["bts_broken_at_peak_1"] = ev.bts_broken_at_peak(p)
+        # (evaluate() has them from the discs' summaries already)
+        row["bts_broken_at_peak_1"] = r["bts_broken_at_peak_1"]
         row["ucs_broken_at_peak_1"] = broken_at_peak(u)
-        if ev.replicates["bts"] > 1:
-            vals = [json.loads((ev.used_folder(p, "bts", i) / "parsed" / "summary.json").read_text())["peak_stress_Pa"]
-                    for i in range(ev.replicates["bts"])]
-            row["bts_cv_1"] = float(np.std(vals, ddof=1) / np.mean(vals))
+        if "bts_cv_1" in r:
+            row["bts_cv_1"] = r["bts_cv_1"]
         if p.clump_size > 1:  # did the intra-clump bonds hold?
             for test in ("ucs", "bts"):
                 used = ev.used_folder(p, test)

@@ -419,6 +419,17 @@ TINY_BTS = {"kind": "brazilian_disc", "diameter_mm": 10, "thickness_mm": 5, "pla
 
 @pytest.mark.engine
 @pytest.mark.skipif(not _lmp_ok(), reason="no LAMMPS binary (run `make setup`)")
+def test_table_of_another_bts_reading_is_refused(tmp_path):
+    card = _card("concrete")
+    calibrate(StandInEvaluator(), card.targets, analytic_start(card.targets), tmp_path / "t.csv", max_evals=2)
+    ev = StandInEvaluator()
+    ev.bts_reading = "split"
+    with pytest.raises(ValueError, match=r"recorded with bts_reading 'peak'.*reads 'split'.*--work"):
+        calibrate(ev, card.targets, analytic_start(card.targets), tmp_path / "t.csv", max_evals=2)
+    with pytest.raises(ValueError, match="bts_reading: 'middle'"):
+        DemEvaluator({}, TINY_UCS, TINY_BTS, tmp_path / "w", bts_reading="middle")
+
+
 def test_tiny_dem_evaluation_and_cache_hit(tmp_path):
     from deckgen.runner import engine_command
 
@@ -446,6 +457,17 @@ def test_tiny_dem_evaluation_and_cache_hit(tmp_path):
     out2 = again.evaluate(MicroParams(10.0, 10.0, 20.0))
     assert again.engine_runs == 0 and out2["engine_runs"] == 0
     assert {k: out2[k] for k in ("ucs_Pa", "bts_Pa", "E_Pa", "ok")} == {k: out[k] for k in ("ucs_Pa", "bts_Pa", "E_Pa", "ok")}
+    # the split reading (docs/calibration.md, "BTS at the split") of the same runs, without an engine run; a summary
+    # written before the split existed gets it from the parsed tables, to the same value
+    split = DemEvaluator(TINY_BASE, TINY_UCS, TINY_BTS, tmp_path / "work", cache=tmp_path / "cache",
+                         command=["false"], name="tiny", bts_reading="split")
+    o3 = split.evaluate(p)
+    assert split.engine_runs == 0 and o3["ucs_Pa"] == out["ucs_Pa"]
+    assert o3["bts_Pa"] == bts["split_stress_Pa"] == o3["bts_split_Pa"] <= bts["peak_stress_Pa"] == out["bts_Pa"]
+    assert bts["split_source"] in ("crack", "peak")
+    summary = ev.used_folder(p, "bts") / "parsed" / "summary.json"
+    summary.write_text(json.dumps({k: v for k, v in bts.items() if "split" not in k}))
+    assert split.evaluate(p)["bts_Pa"] == o3["bts_Pa"]
     # a failing engine makes a failed point, not an exception
     broken = DemEvaluator(TINY_BASE, TINY_UCS, TINY_BTS, tmp_path / "work2", cache=tmp_path / "cache",
                           command=["false"], name="tiny")
@@ -534,10 +556,11 @@ def test_a_point_with_crushed_discs_does_not_converge_and_the_card_says_so(tmp_p
 def test_results_table_says_split_or_crushed_against_the_cards_limit():
     from deckgen.calibration_studies import _split_cell
 
-    assert _split_cell(None, 0.2) == "not recorded"
-    assert _split_cell(0.634, 0.2) == "63% (crushed, limit 20%)"
-    assert _split_cell(0.117, None) == "12% (split, limit 20%)"  # a card without a limit: the default
-    assert _split_cell(0.25, 0.3) == "25% (split, limit 30%)"
+    assert _split_cell(None, 0.2) == "peak: not recorded"
+    assert _split_cell(0.634, 0.2) == "peak: 63% (crushed, limit 20%)"
+    assert _split_cell(0.117, None) == "peak: 12% (split, limit 20%)"  # a card without a limit: the default
+    assert _split_cell(0.25, 0.3) == "peak: 25% (split, limit 30%)"
+    assert _split_cell(0.077, 0.2, "split") == "split: 8% (split, limit 20%)"
 
 
 def test_split_check_passes_a_rock_whose_ratio_needs_no_crushing(tmp_path):

@@ -531,3 +531,70 @@ def test_whole_cycle_means_remove_the_phase_of_a_partial_cycle_window():
     s3 = _cutting_summary(ts, lin)
     assert s3["force_magnitude_N_mean_cycles"] == s3["force_magnitude_N_mean_steady"]
     assert s3["force_magnitude_N_mean_cycles_sliding"] == s3["force_magnitude_N_mean_steady"]
+
+
+# ----------------------------------------------------------------------------- Brazilian split onset
+def _disc(crack_x_mm: float = 0.5, crack_at: float = 0.004, crack_bonds: int = 100, crack_z_mm: float = 6.0,
+          n_bonds: int = 1400, dip_at: float = 0.004):
+    """A synthetic Brazilian record. The stress rises linearly to 0.6 MPa at strain ``dip_at``, dips by 5 % and
+    rises to a 1.2 MPa peak at strain 0.009, then falls. ``crack_bonds`` bonds break at x = ``crack_x_mm`` spread
+    over |z - centre| <= ``crack_z_mm``, evenly over the strain interval ending at ``crack_at`` (half of them in
+    its last 5 %); 10 break far off the diameter before. Disc D 20 mm, grains 0.8-1.333 mm: a diametral plane cuts
+    n l / (pi R) = 1400 x 2.133 / 31.42 = 95.05 bonds, so the split is the 96th crack bond."""
+    eps = np.linspace(0.0, 0.012, 481)
+    split = 0.6e6
+    stress = np.where(eps <= dip_at, split * eps / dip_at,
+                      np.where(eps <= 0.009, 0.95 * split + (2 * split - 0.95 * split) * (eps - dip_at) / (0.009 - dip_at),
+                               2 * split * (1 - 40 * (eps - 0.009))))
+    steps = np.arange(len(eps)) * 100
+    i_c = int(np.searchsorted(eps, crack_at))
+    early = np.linspace(1, 40, 10).astype(int)
+    rows = [(int(steps[i]) - 50, 8.5, 0.0) for i in early]
+    half = crack_bonds // 2
+    slow = np.linspace(0.5 * i_c, 0.95 * i_c, crack_bonds - half).astype(int)
+    fast = np.linspace(0.95 * i_c, i_c, half).astype(int)
+    for k, i in enumerate(np.concatenate([slow, fast])):
+        rows.append((int(steps[i]) - 10, crack_x_mm, -crack_z_mm + 2 * crack_z_mm * k / max(1, crack_bonds - 1)))
+    broken = pd.DataFrame(rows, columns=["step", "x_mm", "z_mm"]).sort_values("step", kind="stable")
+    broken = pd.DataFrame({"step": broken["step"].to_numpy(np.int64), "x_m": broken["x_mm"].to_numpy() * 1e-3,
+                           "y_m": 0.0, "z_m": 0.01 + broken["z_mm"].to_numpy() * 1e-3})
+    bb = np.searchsorted(broken["step"].to_numpy(), steps, side="right")
+    ts = pd.DataFrame({"step": steps, "strain_1": eps, "stress_Pa": stress, "bonds_broken": bb})
+    spec = {"case": {"specimen": {"diameter_mm": 20.0}, "packing": {"radius_min_mm": 0.8, "radius_max_mm": 1.333}},
+            "derived": {"n_bonds": n_bonds, "jaws": {"x": 0.0, "zc_bot": 0.025, "zc_top": -0.005}}}
+    return ts, broken, spec
+
+
+def test_split_reads_the_stress_when_a_diametral_crack_has_broken_not_the_crushing_peak():
+    from deckgen.results import split_onset
+
+    ts, broken, spec = _disc()
+    r = split_onset(ts, broken, spec)
+    assert r["split_source"] == "crack"
+    assert r["split_crack_bonds"] == pytest.approx(1400 * 2.133e-3 / (np.pi * 0.01))
+    assert r["split_stress_Pa"] == pytest.approx(0.6e6, rel=0.01)  # the load at the split, not the 1.2 MPa peak
+    assert r["split_strain_1"] == pytest.approx(0.004, abs=5e-5)
+    assert 10 + 96 <= r["bonds_broken_at_split"] <= 10 + 100  # the far-off early ones and (nearly) the whole crack
+    assert 96 / 110 <= r["split_localisation_1"] <= 96 / 106  # bonds breaking in the same step as the 96th count
+
+
+@pytest.mark.parametrize("why, kw", [
+    ("damage off the loaded diameter (crushing at the side)", {"crack_x_mm": 6.5}),
+    ("damage under the jaws only", {"crack_z_mm": 9.5, "crack_bonds": 100}),  # |z| > 0.7 R for 1/4 of them: < 96 left
+    ("fewer broken bonds than one diametral plane cuts", {"crack_bonds": 90}),
+    ("the crack completes after the peak (a brittle disc)", {"crack_at": 0.0095, "dip_at": 0.004})])
+def test_split_falls_back_to_the_peak(why, kw):
+    from deckgen.results import split_onset
+
+    ts, broken, spec = _disc(**kw)
+    r = split_onset(ts, broken, spec)
+    assert r["split_source"] == "peak", why
+    assert r["split_stress_Pa"] == pytest.approx(float(ts["stress_Pa"].max())), why
+
+
+def test_split_needs_broken_bond_positions():
+    from deckgen.results import split_onset
+
+    ts, broken, spec = _disc()
+    r = split_onset(ts, broken.iloc[0:0], spec)
+    assert r["split_source"] == "peak" and r["split_stress_Pa"] == pytest.approx(float(ts["stress_Pa"].max()))

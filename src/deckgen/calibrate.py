@@ -147,6 +147,14 @@ class CalibrationSetup(_Model):
             "peak, discs crushed between the jaws after their bonds had opened 25-86 % (docs/calibration.md, section "
             "'Split or crushed'). A point converges only when the mean over its discs is within this; above it the "
             "optimiser gets a penalty residual. null: not checked."))
+    bts_reading: Literal["peak", "split"] = Field(
+        "peak", description=(
+            "Which stress of a Brazilian disc is its strength: 'peak' (the largest stress) or 'split' (the largest stress "
+            "until a diametral crack's worth of bonds along the loaded diameter has broken, deckgen.results.split_onset; "
+            "the peak when that happens after it). A flat-joint disc with a high cohesion cracks along its diameter and "
+            "is then crushed between the jaws to a peak 1.2-5x the split (docs/calibration.md, section 'BTS at the "
+            "split'). With 'split' the "
+            "split check reads the fraction of bonds broken at the split."))
     start_table: Literal["ratio", "high_strain", "flat_joint"] = Field(
         "ratio", description=(
             "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
@@ -265,6 +273,7 @@ class Provenance(_Model):
     stop_reason: str = ""
     bts_max_broken_at_peak: float | None = Field(None, description=(
         "The split check the convergence used (calibration.bts_max_broken_at_peak); null: not checked."))
+    bts_reading: str = Field("peak", description="Brazilian reading the calibration used (calibration.bts_reading).")
     deckgen_version: str = __version__
     created: str = ""
 
@@ -953,6 +962,19 @@ def engine_version(command: list[str] | None = None) -> str:
         return "lammps (version unknown)"
 
 
+def _with_split(summary: dict[str, Any], test_dir: Path) -> dict[str, Any]:
+    """A Brazilian summary with the split onset (deckgen.results.split_onset), computed from the parsed tables in
+    ``test_dir`` when the summary was written before it existed (its summary.json is left as it is)."""
+    if "split_stress_Pa" in summary:
+        return summary
+    from deckgen.results import split_onset_on_disk
+
+    try:
+        return {**summary, **split_onset_on_disk(test_dir)}
+    except FileNotFoundError:  # no parsed tables: no split reading
+        return {**summary, "split_stress_Pa": math.nan, "bonds_broken_at_split": math.nan}
+
+
 def broken_at_peak(summary: dict[str, Any]) -> float:
     """Fraction of a test's initial bonds broken at its peak stress (NaN without bonds)."""
     n = _num(summary.get("n_bonds_initial"))
@@ -971,7 +993,10 @@ class DemEvaluator:
                  work_dir: str | Path, *, cache: str | Path | None = None, command: list[str] | None = None,
                  tie_contact_modulus: bool = True, timeout_s: float | None = None, name: str = "cal",
                  parallel: bool = False, ucs_packings: int = 1, bts_packings: int = 1,
-                 extend_attempts: int = 1) -> None:
+                 extend_attempts: int = 1, bts_reading: str = "peak") -> None:
+        if bts_reading not in ("peak", "split"):
+            raise ValueError(f"bts_reading: {bts_reading!r} (fix: 'peak' or 'split')")
+        self.bts_reading = bts_reading
         self.base = base
         # replicate packings per test: the point's value is their mean (packing scatter of a coarse
         # Brazilian disc is ~12 %, more than the tolerance; docs/calibration.md)
@@ -1031,15 +1056,23 @@ class DemEvaluator:
         return last
 
     def bts_broken_at_peak(self, params: MicroParams) -> float:
-        """Mean fraction of the point's Brazilian discs' bonds broken at their peaks, from the runs on disk (NaN
-        when a disc's summary is missing)."""
+        """Mean fraction of the point's Brazilian discs' bonds broken at their peaks (at their splits with
+        ``bts_reading`` 'split'), from the runs on disk (NaN when a disc's summary is missing)."""
         vals = []
         for i in range(self.replicates["bts"]):
-            summary = self.used_folder(params, "bts", i) / "parsed" / "summary.json"
+            folder = self.used_folder(params, "bts", i)
+            summary = folder / "parsed" / "summary.json"
             if not summary.is_file():
                 return math.nan
-            vals.append(broken_at_peak(json.loads(summary.read_text())))
+            vals.append(self._broken(_with_split(json.loads(summary.read_text()), folder)))
         return float(np.mean(vals))
+
+    def _broken(self, summary: dict[str, Any]) -> float:
+        """Fraction of a disc's bonds broken at the stress this evaluator reads as its strength."""
+        if self.bts_reading == "split":
+            n = _num(summary.get("n_bonds_initial"))
+            return _num(summary.get("bonds_broken_at_split")) / n if n > 0 else math.nan
+        return broken_at_peak(summary)
 
     def describe(self) -> dict[str, Any]:
         if self._engine is None:
@@ -1047,7 +1080,7 @@ class DemEvaluator:
         base = Case.model_validate(deep_merge(self.base, {"specimen": self.ucs_specimen}))
         return {"evaluator": "DemEvaluator", "engine": self._engine, "packing_seed": base.packing.seed,
                 "radius_min_mm": base.packing.radius_min_mm, "radius_max_mm": base.packing.radius_max_mm,
-                "ucs_specimen": self.ucs_specimen, "bts_specimen": self.bts_specimen}
+                "ucs_specimen": self.ucs_specimen, "bts_specimen": self.bts_specimen, "bts_reading": self.bts_reading}
 
     def _one(self, params: MicroParams, test: Literal["ucs", "bts"], folder: Path, replicate: int = 0) -> dict[str, Any]:
         from deckgen.deck import render_case
@@ -1072,7 +1105,7 @@ class DemEvaluator:
                          progress=False, timeout_s=self.timeout_s)
                 out = parse_run(run_dir, sub / "parsed")
             if peak_reached(out):
-                return out
+                return _with_split(out, sub) if test == "bts" else out
             # the specimen had not failed when the run reached max_strain: its peak is a lower bound of
             # the strength (a strong point far from the targets); run it again, longer
             sp = self.ucs_specimen if test == "ucs" else self.bts_specimen
@@ -1110,13 +1143,21 @@ class DemEvaluator:
             ucs = [d for (t, _), d in zip(jobs, done) if t == "ucs"]
             bts = [d for (t, _), d in zip(jobs, done) if t == "bts"]
             mean = lambda runs, k: float(np.mean([_num(r.get(k)) for r in runs]))  # noqa: E731
-            out = {"ucs_Pa": mean(ucs, "peak_stress_Pa"), "bts_Pa": mean(bts, "peak_stress_Pa"),
+            bkey = "split_stress_Pa" if self.bts_reading == "split" else "peak_stress_Pa"
+            out = {"ucs_Pa": mean(ucs, "peak_stress_Pa"), "bts_Pa": mean(bts, bkey),
                    "E_Pa": mean(ucs, "youngs_modulus_Pa"), "ok": True, "error": ""}
             # a peak far beyond the rock's UCS/E marks the ductile branch (docs/calibration.md, concrete run)
             out["ucs_strain_at_peak_1"] = mean(ucs, "strain_at_peak_1")
-            out["bts_broken_at_peak_1"] = float(np.mean([broken_at_peak(r) for r in bts]))
+            out["bts_broken_at_peak_1"] = float(np.mean([self._broken(r) for r in bts]))
+            out["bts_peak_Pa"] = mean(bts, "peak_stress_Pa")
+            out["bts_split_Pa"] = mean(bts, "split_stress_Pa")
+            out["bts_broken_at_split_1"] = float(np.mean([_num(r.get("bonds_broken_at_split")) / _num(r.get("n_bonds_initial"))
+                                                          for r in bts]))
             if len(bts) > 1:
-                out["bts_cv_1"] = float(np.std([_num(r.get("peak_stress_Pa")) for r in bts], ddof=1) / out["bts_Pa"])
+                out["bts_split_cv_1"] = float(np.std([_num(r.get("split_stress_Pa")) for r in bts], ddof=1)
+                                              / out["bts_split_Pa"])
+            if len(bts) > 1:
+                out["bts_cv_1"] = float(np.std([_num(r.get(bkey)) for r in bts], ddof=1) / out["bts_Pa"])
             bad = [k for k in ("ucs_Pa", "bts_Pa", "E_Pa") if not (math.isfinite(out[k]) and out[k] > 0)]
             if bad:
                 out.update(ok=False, error=f"non-finite or non-positive {', '.join(bad)} ({folder})")
@@ -1248,7 +1289,8 @@ TABLE_COLUMNS = [
     *OPTIONAL_BOND_FIELDS, "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
     "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
     "bts_error_1", "E_error_1", "ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1",
-    "bts_broken_at_peak_1", "bts_cv_1", "wall_s", "engine_runs", "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
+    "bts_broken_at_peak_1", "bts_cv_1", "bts_reading", "bts_peak_Pa", "bts_split_Pa", "wall_s", "engine_runs",
+    "target_ucs_Pa", "target_bts_Pa", "target_E_Pa", "time_utc",
 ]
 
 
@@ -1337,10 +1379,16 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
 
     recorded: dict[str, dict[str, Any]] = {}
     rows = read_table(table_path)
+    reading = str(getattr(evaluator, "bts_reading", "peak"))
     for row in rows:
         tr = (row["target_ucs_Pa"], row["target_bts_Pa"], row["target_E_Pa"])
         if not np.allclose(tr, (t["ucs"], t["bts"], t["E"]), rtol=1e-9):
             raise ValueError(f"{table_path}: recorded for other targets {tr} (fix: delete it or use another table path)")
+        row_reading = row.get("bts_reading")
+        row_reading = "peak" if not isinstance(row_reading, str) else row_reading  # tables before the column
+        if row_reading != reading:
+            raise ValueError(f"{table_path}: recorded with bts_reading {row_reading!r}, this calibration reads "
+                             f"{reading!r} (fix: use another --out folder, with --work pointing at this one's work/ folder to reuse its runs)")
         recorded[str(row["key"])] = row
 
     history: list[Evaluation] = []
@@ -1389,6 +1437,8 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                 "ucs_to_E_pct": 100 * ev.ucs_Pa / ev.E_Pa if ok else float("nan"),
                 "ucs_strain_at_peak_1": _num(res.get("ucs_strain_at_peak_1")) if ok else float("nan"),
                 "bts_broken_at_peak_1": ev.bts_broken, "bts_cv_1": _num(res.get("bts_cv_1")) if ok else float("nan"),
+                "bts_reading": reading, "bts_peak_Pa": _num(res.get("bts_peak_Pa")),
+                "bts_split_Pa": _num(res.get("bts_split_Pa")),
                 "wall_s": wall, "engine_runs": ev.engine_runs,
                 "target_ucs_Pa": t["ucs"], "target_bts_Pa": t["bts"], "target_E_Pa": t["E"],
                 "time_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
@@ -1403,7 +1453,7 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
                 f"sigma_c {p.tensile_strength_MPa:.4g} MPa, tau_c {p.shear_strength_MPa:.4g} MPa, g {p.gap_tolerance:.3g}, "
                 f"E_c/E_b {p.contact_modulus_ratio:.3g}{_mechanism_text(p)} -> "
                 f"UCS {ev.ucs_Pa / MPA:.4g} MPa ({e[0]:+.1%}), BTS {ev.bts_Pa / MPA:.4g} MPa ({e[1]:+.1%}), "
-                f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%}){_split_text(ev, mb)}")
+                f"E {ev.E_Pa / GPA:.4g} GPa ({e[2]:+.1%}){_split_text(ev, mb, reading)}")
             if np.all(np.abs(e) <= tol) and ev.split(mb):
                 raise _Stop("converged")
         else:
@@ -1471,12 +1521,12 @@ def calibrate(evaluator: Evaluator, targets: CardTargets, start: MicroParams, ta
     return result
 
 
-def _split_text(ev: Evaluation, max_broken: float | None) -> str:
-    """Log text of the Brazilian discs' broken fraction at the peak and whether they split."""
+def _split_text(ev: Evaluation, max_broken: float | None, reading: str = "peak") -> str:
+    """Log text of the Brazilian discs' broken fraction at the reading (peak or split) and whether they split."""
     if not math.isfinite(ev.bts_broken):
-        return "" if max_broken is None else ", BTS discs: broken fraction at peak unknown (runs not on disk), no split"
+        return "" if max_broken is None else f", BTS discs: broken fraction at {reading} unknown (runs not on disk), no split"
     verdict = "" if max_broken is None else (" split" if ev.split(max_broken) else f" CRUSHED (> {max_broken:.0%})")
-    return f", BTS discs {ev.bts_broken:.0%} broken at peak{verdict}"
+    return f", BTS discs {ev.bts_broken:.0%} broken at {reading}{verdict}"
 
 
 def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, space: ParameterSpace) -> MaterialCard:
@@ -1505,6 +1555,7 @@ def make_card(card: MaterialCard, res: CalibrationResult, start: MicroParams, sp
         ucs_specimen=d.get("ucs_specimen", {}), bts_specimen=d.get("bts_specimen", {}),
         parameters=list(space.names), start={k: float(f"{v:.6g}") for k, v in asdict(start).items()},
         table=str(res.table), stop_reason=res.stop_reason, bts_max_broken_at_peak=res.bts_max_broken,
+        bts_reading=str(d.get("bts_reading", "peak")),
         created=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
     )
     return card.model_copy(update={"calibrated": calibrated, "provenance": prov})
@@ -1554,8 +1605,11 @@ def setup_base(card: MaterialCard) -> dict[str, Any]:
 
 def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None = None,
              command: list[str] | None = None, stand_in: bool = False, max_evals: int | None = None,
-             tol: float | None = None, quiet: bool = False, parallel: bool = False) -> CalibrationResult:
-    """Calibrate the card at ``card_path`` into ``out`` (``evaluations.csv``, ``work/``, ``card.yaml``)."""
+             tol: float | None = None, quiet: bool = False, parallel: bool = False,
+             work: str | Path | None = None) -> CalibrationResult:
+    """Calibrate the card at ``card_path`` into ``out`` (``evaluations.csv``, ``work/``, ``card.yaml``); ``work``: the
+    engine runs' folder instead of ``out/work`` (runs are keyed by setup and parameters, so calibrations sharing it
+    answer each other's points from disk)."""
     card = load_card(card_path)
     out = Path(out)
     setup = card.calibration
@@ -1572,10 +1626,10 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
         evaluator: Any = StandInEvaluator()
     else:
         ucs, bts = quasi_static_specimens(card)
-        evaluator = DemEvaluator(base, ucs, bts, out / "work", cache=cache,
+        evaluator = DemEvaluator(base, ucs, bts, Path(work) if work else out / "work", cache=cache,
                                  command=command, tie_contact_modulus=setup.tie_contact_modulus, name=card.rock,
                                  parallel=parallel, ucs_packings=setup.ucs_packings,
-                                 bts_packings=setup.bts_packings)
+                                 bts_packings=setup.bts_packings, bts_reading=setup.bts_reading)
     log = (lambda s: None) if quiet else (lambda s: print(s, flush=True))
     log(f"{card.rock}: start E_b {start.youngs_modulus_GPa:.4g} GPa, sigma_c {start.tensile_strength_MPa:.4g} MPa, "
         f"tau_c {start.shear_strength_MPa:.4g} MPa; parameters {space.names}")
@@ -1599,6 +1653,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("card", help="material card with targets (cases/materials/<rock>.yaml)")
     ap.add_argument("--out", required=True, help="output folder (card.yaml, evaluations.csv, work/)")
     ap.add_argument("--cache", default=None, help="packing cache (default: DECKGEN_CACHE or .deckgen-cache)")
+    ap.add_argument("--work", default=None, help="engine runs' folder (default OUT/work); share it to reuse runs")
     ap.add_argument("--engine-cmd", default=None, help="engine command line, e.g. 'mpirun -np 2 lmp'")
     ap.add_argument("--ranks", type=int, default=None, help="MPI ranks per engine run")
     ap.add_argument("--jobs", type=int, choices=[1, 2], default=1,
@@ -1612,7 +1667,7 @@ def main(argv: list[str] | None = None) -> int:
     command = shlex.split(a.engine_cmd) if a.engine_cmd else (engine_command(ranks) if ranks else None)
     try:
         res = run_card(a.card, a.out, cache=a.cache, command=command, stand_in=a.stand_in,
-                       max_evals=a.max_evals, tol=a.tol, parallel=a.jobs == 2)
+                       max_evals=a.max_evals, tol=a.tol, parallel=a.jobs == 2, work=a.work)
     except (CardError, SpecError, ValueError) as exc:
         print(str(exc), file=sys.stderr)
         return 2

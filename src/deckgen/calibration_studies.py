@@ -330,6 +330,9 @@ def _row(label: str, ev: DemEvaluator, p: MicroParams) -> dict[str, Any]:
         row["ucs_broken_at_peak_1"] = broken_at_peak(u)
         if "bts_cv_1" in r:
             row["bts_cv_1"] = r["bts_cv_1"]
+        # the Brazilian stress when the disc has split (docs/calibration.md, "BTS at the split")
+        row.update({"bts_split_Pa": r["bts_split_Pa"], "ucs_to_bts_split_1": r["ucs_Pa"] / r["bts_split_Pa"],
+                    "bts_broken_at_split_1": r["bts_broken_at_split_1"], "bts_split_cv_1": r.get("bts_split_cv_1", math.nan)})
         if p.clump_size > 1:  # did the intra-clump bonds hold?
             for test in ("ucs", "bts"):
                 used = ev.used_folder(p, test)
@@ -383,6 +386,7 @@ def ratio_study(out: Path, *, base: dict[str, Any] | None = None, ucs: dict[str,
     return _write(rows, out, name, f"UCS/BTS mechanisms, set {variant_set} (deckgen.calibration_studies ratio)",
                   ["variant", "ucs_Pa", "bts_Pa", "E_Pa", "ucs_to_bts_1", "ucs_smoothed_Pa", "bts_smoothed_Pa",
                    "ucs_to_bts_smoothed_1", "bts_cv_1", "poisson_ratio_1", "bts_broken_at_peak_1",
+                   "bts_split_Pa", "ucs_to_bts_split_1", "bts_split_cv_1", "bts_broken_at_split_1",
                    "ucs_bonds_broken", "bts_bonds_broken", "ucs_broken_intra_clump", "bts_broken_intra_clump",
                    "bts_broken_tension", "bts_broken_shear", "ucs_broken_tension", "ucs_broken_shear"])
 
@@ -416,7 +420,7 @@ def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
         # the calibration's own evaluation (its replicate packings), at full and half speed
         ev = DemEvaluator(base, u, b, out / "work" / f"speed_{factor:g}", cache=cache, command=command, name=card.rock,
                           parallel=parallel, ucs_packings=card.calibration.ucs_packings,
-                          bts_packings=card.calibration.bts_packings)
+                          bts_packings=card.calibration.bts_packings, bts_reading=card.calibration.bts_reading)
         row = _row(f"speed x{factor:g}", ev, p)
         row.update({"rock": card.rock, "speed_factor": factor, "ucs_speed_m_s": u["platen_speed_m_s"],
                     "bts_speed_m_s": b["platen_speed_m_s"]})
@@ -438,7 +442,8 @@ def seeds_study(card_path: Path, out: Path, seeds: list[int], *, cache: Path | N
     rows = []
     for seed in seeds:
         b = deep_merge(base, {"packing": {"seed": int(seed)}})
-        ev = DemEvaluator(b, ucs, bts, out / "work" / f"seed_{seed}", cache=cache, command=command, name=card.rock, parallel=parallel)
+        ev = DemEvaluator(b, ucs, bts, out / "work" / f"seed_{seed}", cache=cache, command=command, name=card.rock,
+                          parallel=parallel, bts_reading=card.calibration.bts_reading)
         row = _row(f"seed {seed}", ev, p)
         row.update({"rock": card.rock, "packing_seed": seed})
         rows.append(row)
@@ -469,20 +474,20 @@ def _bond_law(bonds: dict[str, Any]) -> str:
     return ", ".join(["flat joint", *extra])
 
 
-def _split_cell(broken: float | None, limit: float | None) -> str:
-    """Table cell of the calibrated point's Brazilian discs: fraction of bonds broken at the peak, split or crushed
-    against the card's limit (the default when the card has none)."""
+def _split_cell(broken: float | None, limit: float | None, reading: str = "peak") -> str:
+    """Table cell of the calibrated point's Brazilian discs: where the BTS is read (peak or split) and the fraction
+    of bonds broken there, split or crushed against the card's limit (the default when the card has none)."""
     if broken is None:
-        return "not recorded"
+        return f"{reading}: not recorded"
     limit = limit if limit is not None else BTS_MAX_BROKEN_AT_PEAK
-    return f"{broken:.0%} ({'split' if broken <= limit else 'crushed'}, limit {limit:.0%})"
+    return f"{reading}: {broken:.0%} ({'split' if broken <= limit else 'crushed'}, limit {limit:.0%})"
 
 
 def results_table(cards: list[Path], studies: Path) -> str:
     """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
     head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
             "| bond law | E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) "
-            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS | BTS discs: bonds broken at peak |\n"
+            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS | BTS read at: bonds broken there |\n"
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for path in cards:
@@ -523,7 +528,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             f"{_bond_law(b)} | {b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "
             f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {b.get('gap_tolerance', 0.05):.3g} | "
             f"{card.calibrated.contact.get('youngs_modulus_GPa', b['youngs_modulus_GPa']) / b['youngs_modulus_GPa']:.3g} | "
-            f"{seeds} | {seed_err} | {qs} | {_split_cell(a.bts_broken_at_peak, p.bts_max_broken_at_peak)} |")
+            f"{seeds} | {seed_err} | {qs} | {_split_cell(a.bts_broken_at_peak, p.bts_max_broken_at_peak, p.bts_reading)} |")
     return head + "\n".join(lines) + "\n"
 
 

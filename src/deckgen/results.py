@@ -93,7 +93,8 @@ UNITLESS_COLUMNS = frozenset({
     "bonds_intact", "peak_reached", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
     "n_grains_bonded", "n_grains_missing_final", "grains_inside_cutter_final", "steps", "final_step", "damage_step",
-    "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series",
+    "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
+    "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
     "notes", "log_failure",
 })
@@ -146,7 +147,8 @@ PLATEN_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     "bonds_broken_at_peak", "youngs_modulus_Pa", "secant_modulus_Pa", "modulus_fit_points",
     "modulus_fit_intercept_Pa", "modulus_fit_stress_lo_Pa", "modulus_fit_stress_hi_Pa",
     "final_strain_1", "max_strain_1", "post_peak_drop_1", "peak_reached", "area_m2", "height_m", "platen_speed_m_s",
-    "poisson_ratio_1",
+    "poisson_ratio_1", "split_stress_Pa", "split_strain_1", "bonds_broken_at_split", "split_crack_bonds",
+    "split_localisation_1", "split_source",
 ]
 CUTTING_SUMMARY_COLUMNS = _COMMON_SUMMARY + [
     f"{q}_{s}" for q in CUTTING_QUANTITIES for s in ("mean_steady", "mean_cycles", "mean_cycles_sliding", "peak")
@@ -192,6 +194,14 @@ STOPPED_EARLY_FRACTION = 0.99
 #: A peak before this fraction of the final strain is a failure whatever the drop: the load never came
 #: back to it over the last 10 % of the run (a split Brazilian disc whose halves keep some jaw load).
 PEAK_CLEARLY_EARLY_FRACTION = 0.9
+
+#: Brazilian split (docs/calibration.md, section "BTS at the split"): a disc has split when the bonds broken along
+#: its loaded diameter (within SPLIT_BAND R of the loading line and SPLIT_CORE R of the disc centre, the crushed
+#: zones under the jaws left out) number SPLIT_CRACK_SHARE x the bonds one diametral plane cuts,
+#: n_bonds l / (pi R) for bond length l = r_min + r_max (an isotropic bond network).
+SPLIT_CRACK_SHARE = 1.0
+SPLIT_BAND = 0.3
+SPLIT_CORE = 0.7
 
 _PLATEN_TESTS = ("ucs", "bts")
 
@@ -638,6 +648,76 @@ def _platen_summary(ts: pd.DataFrame, spec: dict[str, Any], test: str) -> dict[s
     return out
 
 
+def split_onset(ts: pd.DataFrame, broken: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
+    """Where a Brazilian disc splits: the stress when a diametral crack's worth of bonds along its loaded diameter
+    has broken.
+
+    A disc whose bonds open in tension long before its peak (a flat joint with a low sigma_c/E_b and a high
+    cohesion) cracks along the loaded diameter and is then crushed between the jaws: its load rises again, carried
+    by the broken faces' compression and friction, to a peak 1.2-5x the load at which it split. The split, not that
+    peak, is the disc's tensile failure; a laboratory disc splits at its peak and the test ends there.
+
+    Crack count: the broken bonds within SPLIT_BAND R of the loading line (x of the jaws) and SPLIT_CORE R of the
+    disc centre, in the order they broke; the split is the sample where their number first reaches
+    ``SPLIT_CRACK_SHARE n_bonds l / (pi R)`` (the bonds a diametral plane cuts, l = r_min + r_max).
+    ``split_stress_Pa`` is the largest stress up to that sample, or the peak when the count is reached after the
+    peak or never (a brittle disc splits at its peak and cracks through after it: ``split_source`` "peak";
+    otherwise "crack"). Always ``split_stress_Pa <= peak_stress_Pa``. Also ``split_crack_bonds`` (the count
+    needed), ``split_localisation_1`` (that count over all bonds broken by then: ~0.85 for a diametral crack) and
+    ``bonds_broken_at_split``.
+    """
+    nan = _nan()
+    out: dict[str, Any] = {"split_stress_Pa": nan, "split_strain_1": nan, "bonds_broken_at_split": nan,
+                           "split_crack_bonds": nan, "split_localisation_1": nan, "split_source": "none"}
+    if ts.empty:
+        return out
+    stress = ts["stress_Pa"].to_numpy(dtype=float)
+    bb = ts["bonds_broken"].to_numpy(dtype=float)
+    steps = ts["step"].to_numpy(dtype=np.int64)
+    ip = int(np.argmax(stress))
+    stop = ip  # default: the peak
+    case, derived = spec.get("case", {}), spec.get("derived", {})
+    sp, pk = case.get("specimen", {}), case.get("packing", {})
+    try:
+        R = 0.5e-3 * float(sp["diameter_mm"])
+        bond_len = 1e-3 * (float(pk["radius_min_mm"]) + float(pk["radius_max_mm"]))
+        n0 = float(derived["n_bonds"])
+    except (KeyError, TypeError, ValueError):
+        R = bond_len = n0 = nan
+    jaws = derived.get("jaws") or {}
+    x_load = float(jaws.get("x", 0.0))
+    z_c = (0.5 * (float(jaws["zc_bot"]) + float(jaws["zc_top"])) if {"zc_bot", "zc_top"} <= set(jaws)
+           else 0.5 * float(derived.get("height_m", 2.0 * R)))
+    need = SPLIT_CRACK_SHARE * n0 * bond_len / (math.pi * R) if R > 0 else nan
+    out["split_crack_bonds"] = need
+    if len(broken) and math.isfinite(need) and need > 0:
+        on_diameter = ((np.abs(broken["x_m"].to_numpy(dtype=float) - x_load) < SPLIT_BAND * R)
+                       & (np.abs(broken["z_m"].to_numpy(dtype=float) - z_c) < SPLIT_CORE * R))
+        crack_steps = np.sort(broken["step"].to_numpy(dtype=np.int64)[on_diameter])
+        k = int(math.ceil(need)) - 1
+        if k < len(crack_steps):
+            at = int(crack_steps[k])
+            j = min(int(np.searchsorted(steps, at, side="left")), len(stress) - 1)  # first sample that holds it
+            if j <= ip:
+                stop = int(np.argmax(stress[: j + 1]))
+                out["split_source"] = "crack"
+            out["split_localisation_1"] = (k + 1) / max(1, int((broken["step"].to_numpy() <= at).sum()))
+    if out["split_source"] == "none":
+        out["split_source"] = "peak"
+    out.update(split_stress_Pa=float(stress[stop]), split_strain_1=float(ts["strain_1"].iloc[stop]),
+               bonds_broken_at_split=int(bb[stop]))
+    return out
+
+
+def split_onset_on_disk(test_dir: str | Path) -> dict[str, Any]:
+    """:func:`split_onset` of a parsed Brazilian test folder (``<test_dir>/run/spec.json``, ``<test_dir>/parsed/``
+    timeseries and broken tables): for summaries written before the split onset existed."""
+    d = Path(test_dir)
+    spec = json.loads((d / "run" / "spec.json").read_text())
+    return split_onset(pd.read_parquet(d / "parsed" / "timeseries.parquet"),
+                       pd.read_parquet(d / "parsed" / "broken.parquet"), spec)
+
+
 def peak_reached(summary: dict[str, Any]) -> bool:
     """Did the platen test fail, i.e. is ``peak_stress_Pa`` a strength?
 
@@ -890,6 +970,8 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
     }
     if test in _PLATEN_TESTS:
         summary.update(_platen_summary(ts, spec, test))
+        if test == "bts":
+            summary.update(split_onset(ts, broken, spec))
         if not ts.empty and not summary["peak_reached"]:
             state.notes.append(f"no failure: the stress at the last sample is {100 * summary['post_peak_drop_1']:.0f} % below "
                                f"the peak (strain at peak {summary['strain_at_peak_1']:.4g} of {summary['final_strain_1']:.4g}); "

@@ -152,9 +152,8 @@ class CalibrationSetup(_Model):
             "Which stress of a Brazilian disc is its strength: 'peak' (the largest stress) or 'split' (the largest stress "
             "until a diametral crack's worth of bonds along the loaded diameter has broken, deckgen.results.split_onset; "
             "the peak when that happens after it). A flat-joint disc with a high cohesion cracks along its diameter and "
-            "is then crushed between the jaws to a peak 1.2-5x the split (docs/calibration.md, section 'BTS at the "
-            "split'). With 'split' the "
-            "split check reads the fraction of bonds broken at the split."))
+            "is then crushed between the jaws to a peak 1.2-4x the split (docs/calibration.md, section 'BTS at the "
+            "split'). With 'split' the split check reads the fraction of bonds broken at the split."))
     start_table: Literal["ratio", "high_strain", "flat_joint"] = Field(
         "ratio", description=(
             "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
@@ -1154,10 +1153,8 @@ class DemEvaluator:
             out["bts_broken_at_split_1"] = float(np.mean([_num(r.get("bonds_broken_at_split")) / _num(r.get("n_bonds_initial"))
                                                           for r in bts]))
             if len(bts) > 1:
-                out["bts_split_cv_1"] = float(np.std([_num(r.get("split_stress_Pa")) for r in bts], ddof=1)
-                                              / out["bts_split_Pa"])
-            if len(bts) > 1:
-                out["bts_cv_1"] = float(np.std([_num(r.get(bkey)) for r in bts], ddof=1) / out["bts_Pa"])
+                cv = lambda k: float(np.std([_num(r.get(k)) for r in bts], ddof=1) / mean(bts, k))  # noqa: E731
+                out["bts_cv_1"], out["bts_split_cv_1"] = cv(bkey), cv("split_stress_Pa")
             bad = [k for k in ("ucs_Pa", "bts_Pa", "E_Pa") if not (math.isfinite(out[k]) and out[k] > 0)]
             if bad:
                 out.update(ok=False, error=f"non-finite or non-positive {', '.join(bad)} ({folder})")

@@ -654,7 +654,7 @@ def split_onset(ts: pd.DataFrame, broken: pd.DataFrame, spec: dict[str, Any]) ->
 
     A disc whose bonds open in tension long before its peak (a flat joint with a low sigma_c/E_b and a high
     cohesion) cracks along the loaded diameter and is then crushed between the jaws: its load rises again, carried
-    by the broken faces' compression and friction, to a peak 1.2-5x the load at which it split. The split, not that
+    by the broken faces' compression and friction, to a peak 1.2-4x the load at which it split. The split, not that
     peak, is the disc's tensile failure; a laboratory disc splits at its peak and the test ends there.
 
     Crack count: the broken bonds within SPLIT_BAND R of the loading line (x of the jaws) and SPLIT_CORE R of the

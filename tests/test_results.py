@@ -598,3 +598,14 @@ def test_split_needs_broken_bond_positions():
     ts, broken, spec = _disc()
     r = split_onset(ts, broken.iloc[0:0], spec)
     assert r["split_source"] == "peak" and r["split_stress_Pa"] == pytest.approx(float(ts["stress_Pa"].max()))
+
+
+def test_split_map_marks_the_bonds_broken_by_the_split(tmp_path):
+    from deckgen.plots import _split_map
+    from deckgen.results import split_onset
+
+    ts, broken, spec = _disc()
+    s = {"case": "synthetic", "test": "bts", "engine": "lammps", "height_m": 0.02, **split_onset(ts, broken, spec)}
+    png = _split_map(s, ts, broken, tmp_path / "split.png")
+    assert png is not None and png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+    assert _split_map(s, ts, broken.iloc[0:0], tmp_path / "none.png") is None

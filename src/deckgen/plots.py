@@ -86,6 +86,9 @@ def _stress_strain(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Pat
     if _finite(summary.get("peak_stress_Pa")):
         ax.plot([summary["strain_at_peak_1"] * 100], [summary["peak_stress_Pa"] / 1e6], "o", color="tab:red",
                 label=f"peak {summary['peak_stress_Pa'] / 1e6:.3g} MPa")
+    if summary.get("split_source") == "crack" and _finite(summary.get("split_stress_Pa")):
+        ax.plot([summary["split_strain_1"] * 100], [summary["split_stress_Pa"] / 1e6], "s", color="tab:green",
+                label=f"split {summary['split_stress_Pa'] / 1e6:.3g} MPa (a crack's worth of bonds on the diameter)")
     key = "youngs_modulus_Pa" if summary["test"] == "ucs" else "secant_modulus_Pa"
     E, b = summary.get(key), summary.get("modulus_fit_intercept_Pa")
     if _finite(E) and _finite(b):
@@ -177,6 +180,41 @@ def _damage_snapshot(summary: dict[str, Any], dmg: pd.DataFrame, path: Path) -> 
     return _save(fig, path)
 
 
+def _split_map(summary: dict[str, Any], ts: pd.DataFrame, broken: pd.DataFrame, path: Path) -> Path | None:
+    """Brazilian disc: where its bonds broke, in the x-z plane, those broken by the split reading
+    (deckgen.results.split_onset) dark and the later ones light, with the band along the loaded diameter that the
+    reading counts (|x| < SPLIT_BAND R, |z - centre| < SPLIT_CORE R)."""
+    from matplotlib.patches import Rectangle
+
+    from deckgen.results import SPLIT_BAND, SPLIT_CORE
+
+    if broken.empty or not _finite(summary.get("split_strain_1")):
+        return None
+    i = int(np.argmin(np.abs(ts["strain_1"].to_numpy(dtype=float) - float(summary["split_strain_1"]))))
+    at = int(ts["step"].iloc[i])
+    early = broken["step"].to_numpy() <= at
+    fig = Figure(figsize=(6.5, 6.0), dpi=120, layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    x, z = broken["x_m"].to_numpy() * 1e3, broken["z_m"].to_numpy() * 1e3
+    ax.plot(x[~early], z[~early], ".", color="0.75", ms=4, label=f"broken after ({int((~early).sum())})")
+    ax.plot(x[early], z[early], ".", color="tab:red", ms=5, label=f"broken by the split ({int(early.sum())})")
+    R = 0.5 * float(summary.get("height_m", np.nan)) * 1e3  # the disc stands on z = 0, centred on x = 0
+    if np.isfinite(R):
+        zc = R
+        ax.add_patch(Rectangle((-SPLIT_BAND * R, zc - SPLIT_CORE * R), 2 * SPLIT_BAND * R, 2 * SPLIT_CORE * R,
+                               fill=False, ls="--", color="tab:green", label="counted band"))
+        t = np.linspace(0, 2 * np.pi, 200)
+        ax.plot(R * np.cos(t), zc + R * np.sin(t), color="black", lw=0.8)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.legend(loc="upper right", fontsize="small")
+    src = summary.get("split_source")
+    ax.set_title(_title(summary, f"broken bonds at the split ({src})"), fontsize="small")
+    return _save(fig, path)
+
+
 def plot_run(parsed_dir: str | Path, plots_dir: str | Path) -> list[Path]:
     """Write the PNG plots of one parsed run into ``plots_dir``; return their paths."""
     parsed_dir = Path(parsed_dir)
@@ -200,4 +238,8 @@ def plot_run(parsed_dir: str | Path, plots_dir: str | Path) -> list[Path]:
         snap = _damage_snapshot(summary, read_table(parsed_dir / "damage"), plots_dir / f"{case}_damage.png")
         if snap is not None:
             out.append(snap)
+    if summary["test"] == "bts" and "split_strain_1" in summary:
+        split = _split_map(summary, ts, read_table(parsed_dir / "broken"), plots_dir / f"{case}_split.png")
+        if split is not None:
+            out.append(split)
     return out

@@ -151,17 +151,27 @@ def test_reduced_scale_headers_state_the_scaling():
             assert ("placeholder" in head) != ("calibrated card" in head)
 
 
-def test_family_bonds_keep_the_rocks_failure_strain_when_softened():
+def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     """Softening divides moduli and strengths alike: sigma_c/E_b (the bond failure strain) is the unsoftened one."""
-    b, c, lines = fam.rock_micro("colorado_red_granite")
-    # placeholder: smoke rock (E_b 40 GPa, sigma 30 MPa -> UCS 19.7 MPa, E 12 GPa) scaled to E 41 GPa, UCS 158 MPa
-    assert b["youngs_modulus_GPa"] == pytest.approx(40 * 41 / 12, rel=1e-3)
-    assert b["tensile_strength_MPa"] == pytest.approx(30 * 158 / 19.7, rel=1e-3)
-    assert b["shear_strength_MPa"] == pytest.approx(2 * b["tensile_strength_MPa"], rel=1e-3)
-    bs, cs, ls = fam.rock_micro("colorado_red_granite", soften_to_GPa=10)
-    assert bs["youngs_modulus_GPa"] == 10 and cs["youngs_modulus_GPa"] == pytest.approx(10)
-    assert bs["tensile_strength_MPa"] / 10 == pytest.approx(b["tensile_strength_MPa"] / b["youngs_modulus_GPa"], rel=1e-3)
-    assert "forces are 1/13.667" in " ".join(ls)
+    with monkeypatch.context() as m:  # a rock without a converged card (all four have one since session 15)
+        m.setattr(fam, "calibrated_card", lambda rock: None)
+        b, c, lines = fam.rock_micro("colorado_red_granite")
+        # placeholder: smoke rock (E_b 40 GPa, sigma 30 MPa -> UCS 19.7 MPa, E 12 GPa) scaled to E 41 GPa, UCS 158 MPa
+        assert b["youngs_modulus_GPa"] == pytest.approx(40 * 41 / 12, rel=1e-3)
+        assert b["tensile_strength_MPa"] == pytest.approx(30 * 158 / 19.7, rel=1e-3)
+        assert b["shear_strength_MPa"] == pytest.approx(2 * b["tensile_strength_MPa"], rel=1e-3)
+        assert "placeholder" in " ".join(lines)
+        bs, cs, ls = fam.rock_micro("colorado_red_granite", soften_to_GPa=10)
+        assert bs["youngs_modulus_GPa"] == 10 and cs["youngs_modulus_GPa"] == pytest.approx(10)
+        assert bs["tensile_strength_MPa"] / 10 == pytest.approx(b["tensile_strength_MPa"] / b["youngs_modulus_GPa"], rel=1e-3)
+        assert "forces are 1/13.667" in " ".join(ls)
+    # the calibrated granite card (flat joint) softened to E_b 10 GPa keeps its bond law and failure strain
+    g = yaml.safe_load((ROOT / "cases/materials/colorado_red_granite.yaml").read_text())["calibrated"]["bonds"]
+    bg, cg, lg = fam.rock_micro("colorado_red_granite", soften_to_GPa=10)
+    assert bg["model"] == "flat_joint" and bg["moment_contribution"] == 0 and bg["youngs_modulus_GPa"] == 10
+    assert bg["tensile_strength_MPa"] / 10 == pytest.approx(g["tensile_strength_MPa"] / g["youngs_modulus_GPa"], rel=1e-3)
+    assert bg["shear_strength_MPa"] / bg["tensile_strength_MPa"] == pytest.approx(g["shear_strength_MPa"] / g["tensile_strength_MPa"], rel=1e-3)
+    assert "calibrated card" in " ".join(lg)
     # a converged card is used as calibrated (limestone: E_b 58.2 GPa, sigma = tau 42.7 MPa, g ~ 0)
     card = yaml.safe_load((ROOT / "cases/materials/savonniere_limestone.yaml").read_text())["calibrated"]
     bl, cl, ll = fam.rock_micro("savonniere_limestone", soften_to_GPa=10)
@@ -169,11 +179,23 @@ def test_family_bonds_keep_the_rocks_failure_strain_when_softened():
     assert bl["tensile_strength_MPa"] == pytest.approx(card["bonds"]["tensile_strength_MPa"] / F, rel=1e-3)
     assert bl["gap_tolerance"] == card["bonds"]["gap_tolerance"] and cl["friction"] == card["contact"]["friction"]
     assert "calibrated card" in " ".join(ll)
-    # a card without a converged calibration is not used (granite has none); a flat-joint card keeps its bond law
-    # (sandstone and concrete, converged with the Brazilian strength read at the split, session 15)
-    assert fam.calibrated_card("colorado_red_granite") is None
-    for rock in ("sandstone", "concrete"):
+    # a flat-joint card keeps its bond law (sandstone, concrete and granite, converged with the Brazilian strength read
+    # at the split, session 15); a card without a converged calibration is not used
+    for rock in ("sandstone", "concrete", "colorado_red_granite"):
         assert fam.calibrated_card(rock)["bonds"]["model"] == "flat_joint", rock
+    assert fam.calibrated_card("no_such_rock") is None
+
+
+def test_a_card_that_did_not_converge_is_not_used(tmp_path, monkeypatch):
+    import deckgen.render
+
+    (tmp_path / "cases" / "materials").mkdir(parents=True)
+    src = ROOT / "docs" / "calibration_runs" / "sandstone_peak_reading_card.yaml"  # session 14: NOT converged
+    assert "converged: false" in src.read_text()
+    (tmp_path / "cases" / "materials" / "sandstone.yaml").write_text(src.read_text())
+    monkeypatch.setattr(deckgen.render, "repo_root", lambda: tmp_path)
+    assert fam.calibrated_card("sandstone") is None
+    assert "placeholder" in " ".join(fam.rock_micro("sandstone")[2])
 
 
 def test_reduced_scale_numbers_follow_the_stated_factors():

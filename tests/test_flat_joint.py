@@ -255,14 +255,20 @@ def test_flat_joint_start_table_returns_a_measured_point_for_its_own_macro_value
     from deckgen.calibrate import MICRO_MACRO_FLAT_JOINT, CardTargets, ParameterSpace, analytic_start, prior_jacobian
 
     sp = ParameterSpace(["log_E_b", "log_sigma_c", "log_tau_ratio"], bounds={"log_tau_ratio": (0.0, 4.6)})
-    sigma_c, c, E, ucs, bts = MICRO_MACRO_FLAT_JOINT[3]  # c/sigma_c 16 at c 120 MPa: UCS/BTS 11.9
-    t = CardTargets(density_kg_m3=2450, ucs_MPa=ucs, bts_MPa=bts, youngs_modulus_GPa=E, poisson_ratio=0.2,
-                    citation="table row")
-    p = analytic_start(t, None, sp, table="flat_joint")
-    assert (p.youngs_modulus_GPa, p.tensile_strength_MPa, p.shear_strength_MPa) == pytest.approx((20.0, sigma_c, c), rel=1e-6)
-    assert p.flat_joint == 1 and p.moment_contribution == 0.0 and p.gap_tolerance == 0.4
-    J = prior_jacobian(sp, "flat_joint")  # rows UCS, BTS, E; columns E_b, sigma_c, c/sigma_c
-    assert J[2, 0] > 0.8 and J[1, 1] > 0.8 and J[0, 2] > J[1, 2] > 0  # c/sigma_c raises UCS more than BTS
+    sigma_c, c, E, ucs, bts, bts_split = MICRO_MACRO_FLAT_JOINT[3]  # c/sigma_c 16 at c 120 MPa: UCS/BTS 11.9 (28.1)
+    for table, b in (("flat_joint", bts), ("flat_joint_split", bts_split)):
+        t = CardTargets(density_kg_m3=2450, ucs_MPa=ucs, bts_MPa=b, youngs_modulus_GPa=E, poisson_ratio=0.2,
+                        citation="table row")
+        p = analytic_start(t, None, sp, table=table)
+        assert (p.youngs_modulus_GPa, p.tensile_strength_MPa, p.shear_strength_MPa) == pytest.approx((20.0, sigma_c, c),
+                                                                                                      rel=1e-6), table
+        assert p.flat_joint == 1 and p.moment_contribution == 0.0 and p.gap_tolerance == 0.4
+        J = prior_jacobian(sp, table)  # rows UCS, BTS, E; columns E_b, sigma_c, c/sigma_c
+        assert J[2, 0] > 0.8 and J[1, 1] > 0.8 and J[0, 2] > J[1, 2] > 0, table  # c/sigma_c raises UCS more than BTS
+    # read at the split, BTS falls faster with c/sigma_c: the split table needs a lower c/sigma_c for a given ratio
+    assert prior_jacobian(sp, "flat_joint_split")[1, 2] < prior_jacobian(sp, "flat_joint")[1, 2]
+    with pytest.raises(ValueError, match="unknown table 'split'"):
+        analytic_start(t, None, sp, table="split")
 
 
 def test_a_calibrated_card_keeps_the_bond_model_token_and_refuses_others():

@@ -154,13 +154,14 @@ class CalibrationSetup(_Model):
             "the peak when that happens after it). A flat-joint disc with a high cohesion cracks along its diameter and "
             "is then crushed between the jaws to a peak 1.2-4x the split (docs/calibration.md, section 'BTS at the "
             "split'). With 'split' the split check reads the fraction of bonds broken at the split."))
-    start_table: Literal["ratio", "high_strain", "flat_joint"] = Field(
+    start_table: Literal["ratio", "high_strain", "flat_joint", "flat_joint_split"] = Field(
         "ratio", description=(
             "Measured micro-macro table of the analytic start and the optimiser's prior Jacobian: 'ratio' (bond failure "
             "strain sigma_c/E_b 0.75e-3; UCS/BTS from the interaction range g) or 'high_strain' (sigma_c/E_b 3e-3 to "
             "6e-3 at g 0.4 and E_c/E_b 4; UCS/BTS from a low tau_c/sigma_c), for rocks with UCS/E above ~0.5 %; "
             "'flat_joint' (bonds.model flat_joint with beta 0, g 0.4, E_c/E_b 4: UCS/BTS from a high c/sigma_c; the "
-            "start sets flat_joint and moment_contribution 0)."))
+            "start sets flat_joint and moment_contribution 0); 'flat_joint_split' the same with the table's BTS read at "
+            "the split (for bts_reading 'split')."))
     bounds: dict[ParamName, tuple[float, float]] = Field(
         default_factory=dict, description=(
             "Bounds of optimiser parameters in the optimiser's units (log of the physical value for log_*), "
@@ -556,18 +557,22 @@ HIGH_STRAIN_GAP, HIGH_STRAIN_CONTACT_RATIO = 0.4, 4.0
 #: -m deckgen.calibration_studies ratio --set flat-joint --card cases/materials/sandstone.yaml --bts-packings 3
 #: --bts-stop 0.2``; docs/calibration_runs/ratio_flat_joint.csv): E_b 20 GPa, g 0.4, contact modulus 4 E_b,
 #: sandstone density and platen speeds, coarse grains, BTS the mean of three discs. Rows: (sigma_c MPa, c MPa,
-#: E GPa, UCS MPa, BTS MPa). UCS/BTS rises with c/sigma_c: 5.8, 8.3, 8.3, 11.9, 14.6 at 2, 4, 8, 16, 32 (c 120
-#: MPa); at c/sigma_c 2 it hardly moves with the strengths (5.8, 6.5, 6.6 at c 120, 60, 30 MPa).
-MICRO_MACRO_FLAT_JOINT: tuple[tuple[float, float, float, float, float], ...] = (
-    (60.0, 120.0, 14.69, 321.8, 55.20),
-    (30.0, 120.0, 14.20, 286.6, 34.50),
-    (15.0, 120.0, 12.65, 231.9, 28.11),
-    (7.5, 120.0, 11.93, 209.5, 17.56),
-    (3.75, 120.0, 11.07, 187.9, 12.84),
-    (30.0, 60.0, 13.95, 167.8, 25.76),
-    (15.0, 30.0, 13.07, 85.25, 12.94),
+#: E GPa, UCS MPa, BTS MPa at the peak, BTS MPa at the split). UCS/BTS rises with c/sigma_c: 5.8, 8.3, 8.3, 11.9,
+#: 14.6 at 2, 4, 8, 16, 32 (c 120 MPa) read at the peak, 5.8, 9.8, 16.7, 28.1, 56.2 read at the split
+#: (deckgen.results.split_onset); at c/sigma_c 2 it hardly moves with the strengths (5.8, 6.5, 6.6 at c 120, 60,
+#: 30 MPa).
+MICRO_MACRO_FLAT_JOINT: tuple[tuple[float, float, float, float, float, float], ...] = (
+    (60.0, 120.0, 14.69, 321.8, 55.20, 55.20),
+    (30.0, 120.0, 14.20, 286.6, 34.50, 29.13),
+    (15.0, 120.0, 12.65, 231.9, 28.11, 13.89),
+    (7.5, 120.0, 11.93, 209.5, 17.56, 7.454),
+    (3.75, 120.0, 11.07, 187.9, 12.84, 3.346),
+    (30.0, 60.0, 13.95, 167.8, 25.76, 25.76),
+    (15.0, 30.0, 13.07, 85.25, 12.94, 12.65),
 )
 FLAT_JOINT_E_B_GPA = 20.0
+#: The measured tables analytic_start and prior_jacobian read (calibration.start_table).
+START_TABLES = ("ratio", "high_strain", "flat_joint", "flat_joint_split")
 
 
 def _loglin(values: list[float], at: list[float], x: float) -> float:
@@ -620,13 +625,14 @@ def _root_or_nearest(f: Callable[[float], float], a: float, b: float, xtol: floa
     return a if abs(fa) < abs(fb) else b
 
 
-def micro_macro_flat_joint(s: float, r: float) -> tuple[float, float, float]:
+def micro_macro_flat_joint(s: float, r: float, split: bool = False) -> tuple[float, float, float]:
     """(E/E_b, UCS/c, BTS/c) of :data:`MICRO_MACRO_FLAT_JOINT` at shear failure strain s = c/E_b and c/sigma_c
     ``r``: log-linear in log r at c/E_b 6e-3 plus the change in log s at c/sigma_c 2 (no cross term measured;
-    extrapolated outside the measured ranges)."""
+    extrapolated outside the measured ranges). ``split``: the BTS read at the split, else at the peak."""
     rows = np.array(MICRO_MACRO_FLAT_JOINT)
     r_all, s_all = rows[:, 1] / rows[:, 0], rows[:, 1] / (FLAT_JOINT_E_B_GPA * 1e3)
-    vals = np.column_stack([rows[:, 2] / FLAT_JOINT_E_B_GPA, rows[:, 3] / rows[:, 1], rows[:, 4] / rows[:, 1]])
+    vals = np.column_stack([rows[:, 2] / FLAT_JOINT_E_B_GPA, rows[:, 3] / rows[:, 1],
+                            rows[:, 5 if split else 4] / rows[:, 1]])
     s_ref = float(s_all.max())
     at_r = np.isclose(s_all, s_ref)
     at_s = np.isclose(r_all, 2.0)
@@ -643,16 +649,18 @@ def micro_macro_flat_joint(s: float, r: float) -> tuple[float, float, float]:
     return tuple(out)  # type: ignore[return-value]
 
 
-def _flat_joint_macro(E_b: float, sigma_c: float, r: float) -> tuple[float, float, float]:
-    """(UCS MPa, BTS MPa, E GPa) of the flat-joint table at E_b [GPa], sigma_c [MPa], c/sigma_c r."""
+def _flat_joint_macro(E_b: float, sigma_c: float, r: float, split: bool = False) -> tuple[float, float, float]:
+    """(UCS MPa, BTS MPa, E GPa) of the flat-joint table at E_b [GPa], sigma_c [MPa], c/sigma_c r (``split``: BTS at
+    the split)."""
     c = sigma_c * r
-    cE, cU, cB = micro_macro_flat_joint(c / (E_b * 1e3), r)
+    cE, cU, cB = micro_macro_flat_joint(c / (E_b * 1e3), r, split)
     return c * cU, c * cB, E_b * cE
 
 
-def _start_flat_joint(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroParams:
+def _start_flat_joint(t: CardTargets, base: Case, sp: ParameterSpace, split: bool = False) -> MicroParams:
     """Start from the flat-joint table (beta 0): c/sigma_c for UCS/BTS, c/E_b for UCS/E, then E_b for E (fixed
-    point, 50 sweeps; c/sigma_c within the bounds of ``log_tau_ratio`` when it is free)."""
+    point, 50 sweeps; c/sigma_c within the bounds of ``log_tau_ratio`` when it is free). ``split``: the table's BTS
+    read at the split."""
     from scipy.optimize import brentq
 
     lo_r, hi_r = 1.0, 64.0
@@ -663,21 +671,21 @@ def _start_flat_joint(t: CardTargets, base: Case, sp: ParameterSpace) -> MicroPa
     s, r = 6e-3, 8.0
     for _ in range(50):
         def fr(lr: float) -> float:
-            _, a, b = micro_macro_flat_joint(s, math.exp(lr))
+            _, a, b = micro_macro_flat_joint(s, math.exp(lr), split)
             return math.log(a / b) - want_ratio
 
         a, b = math.log(lo_r), math.log(hi_r)
         r = math.exp(_root_or_nearest(fr, a, b, 1e-10))
 
         def fs(ls: float) -> float:
-            cE, cU, _ = micro_macro_flat_joint(math.exp(ls), r)
+            cE, cU, _ = micro_macro_flat_joint(math.exp(ls), r, split)
             return math.log(cU * math.exp(ls) / cE) - want_ue
 
         new = math.exp(brentq(fs, math.log(1e-5), math.log(1e-1), xtol=1e-12))
         if abs(math.log(new / s)) < 1e-10:
             break
         s = new
-    cE, _, _ = micro_macro_flat_joint(s, r)
+    cE, _, _ = micro_macro_flat_joint(s, r, split)
     E_b = t.youngs_modulus_GPa / cE
     c = s * E_b * 1e3
     return MicroParams(
@@ -735,7 +743,8 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
 
     ``table="high_strain"``: :func:`micro_macro_high_strain` instead (g 0.4 and E_c/E_b 4 as measured;
     tau_c/sigma_c sets UCS/BTS, within the bounds of ``log_tau_ratio`` when it is free).
-    ``table="flat_joint"``: :func:`micro_macro_flat_joint` (the flat joint with beta 0, g 0.4, E_c/E_b 4).
+    ``table="flat_joint"``: :func:`micro_macro_flat_joint` (the flat joint with beta 0, g 0.4, E_c/E_b 4);
+    ``"flat_joint_split"``: the same with the BTS read at the split (for ``bts_reading: split``).
     """
     if base_case is None:
         base = Case()
@@ -745,10 +754,10 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         base = Case.model_validate(base_case)
     t = targets
     sp = space or ParameterSpace()
-    if table not in ("ratio", "high_strain", "flat_joint"):
-        raise ValueError(f"analytic_start: unknown table {table!r} (fix: 'ratio', 'high_strain' or 'flat_joint')")
-    if table == "flat_joint":  # only the optimiser's parameters are clipped (the flat joint refuses torque factors)
-        p = _start_flat_joint(t, base, sp)
+    if table not in START_TABLES:
+        raise ValueError(f"analytic_start: unknown table {table!r} (fix: one of {', '.join(START_TABLES)})")
+    if table.startswith("flat_joint"):  # only the optimiser's parameters are clipped (the flat joint refuses torque factors)
+        p = _start_flat_joint(t, base, sp, split=table == "flat_joint_split")
         return sp.from_vector(sp.clip_inside(sp.to_vector(p), 1e-3), p)
     if table == "high_strain":
         p = _start_high_strain(t, base, sp)
@@ -808,15 +817,16 @@ def _prior_high_strain(space: ParameterSpace) -> np.ndarray:
     return base
 
 
-def _prior_flat_joint(space: ParameterSpace) -> np.ndarray:
+def _prior_flat_joint(space: ParameterSpace, split: bool = False) -> np.ndarray:
     """Prior Jacobian from :func:`_flat_joint_macro` by central differences at E_b 20 GPa, sigma_c 7.5 MPa,
-    c/sigma_c 16 (the middle of the table); the other columns as in the 'ratio' prior."""
+    c/sigma_c 16 (the middle of the table; ``split``: BTS at the split); the other columns as in the 'ratio'
+    prior."""
     base = prior_jacobian(space, "ratio")
     x0 = np.log([FLAT_JOINT_E_B_GPA, 7.5, 16.0])
     h = 0.1
 
     def out(x: np.ndarray) -> np.ndarray:
-        return np.log(_flat_joint_macro(*np.exp(x)))
+        return np.log(_flat_joint_macro(*np.exp(x), split=split))
 
     cols = {}
     for k, name in enumerate(("log_E_b", "log_sigma_c", "log_tau_ratio")):
@@ -835,8 +845,8 @@ def prior_jacobian(space: ParameterSpace, table: str = "ratio") -> np.ndarray:
     ``table="high_strain"``: :func:`_prior_high_strain`."""
     if table == "high_strain":
         return _prior_high_strain(space)
-    if table == "flat_joint":
-        return _prior_flat_joint(space)
+    if table.startswith("flat_joint"):
+        return _prior_flat_joint(space, split=table == "flat_joint_split")
     (E1, U1, B1), (E2, U2, B2) = micro_macro(0.05, 0.5), micro_macro(0.05, 2.0)
     (Eg0, Ug0, Bg0), (Eg1, Ug1, Bg1) = micro_macro(0.05, 1.0), micro_macro(0.4, 1.0)  # the rising branch
     lr = math.log(4.0)

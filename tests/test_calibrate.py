@@ -97,7 +97,7 @@ def test_card_round_trip_and_case_overrides(tmp_path):
     ({"calibration": {"bounds": {"log_tau_ratio": [-2.0, 0.5]}}}, "bounds: log_tau_ratio is not in parameters"),
     ({"calibration": {"parameters": ["log_E_b", "log_sigma_c", "log_tau_ratio"], "bounds": {"log_tau_ratio": [0.5, -2.0]}}},
      "bounds: log_tau_ratio: need finite lower < upper"),
-    ({"calibration": {"start_table": "medium"}}, "calibration.start_table: Input should be 'ratio', 'high_strain' or 'flat_joint'"),
+    ({"calibration": {"start_table": "medium"}}, "calibration.start_table: Input should be 'ratio', 'high_strain', 'flat_joint' or 'flat_joint_split'"),
     ({"calibrated": {"bonds": {"clump_size": 0}}}, "calibrated.bonds: clump_size"),
 ])
 def test_bad_card_field_gives_clear_error(tmp_path, patch, expect):

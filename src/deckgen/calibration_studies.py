@@ -425,6 +425,8 @@ def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
         row.update({"rock": card.rock, "speed_factor": factor, "ucs_speed_m_s": u["platen_speed_m_s"],
                     "bts_speed_m_s": b["platen_speed_m_s"]})
         rows.append(row)
+        if factor == 1.0 and row["ok"]:  # failure patterns of the calibrated point (issue #3: a snapshot per test)
+            failure_snapshots(ev, p, out / f"plots_{card.rock}")
     df = pd.DataFrame(rows)
     for k in ("ucs_Pa", "bts_Pa", "E_Pa"):
         df[f"{k.removesuffix('_Pa')}_change_at_half_speed_1"] = df[k] / df[k].iloc[0] - 1.0
@@ -432,6 +434,17 @@ def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
                   f"Quasi-static check, {card.rock} (deckgen.calibration_studies quasistatic)",
                   ["variant", "ucs_speed_m_s", "bts_speed_m_s", "ucs_Pa", "bts_Pa", "E_Pa",
                    "ucs_change_at_half_speed_1", "bts_change_at_half_speed_1", "E_change_at_half_speed_1"])
+
+
+def failure_snapshots(ev: DemEvaluator, p: MicroParams, out: Path) -> list[Path]:
+    """Plots of a point's first UCS cylinder and first Brazilian disc (deckgen.plots.plot_run: stress-strain, broken
+    bonds, the damage-coloured failure pattern and, for the disc, where its bonds broke by the split) into ``out``."""
+    from deckgen.plots import plot_run
+
+    files: list[Path] = []
+    for test in ("ucs", "bts"):
+        files += plot_run(ev.used_folder(p, test) / "parsed", out)
+    return files
 
 
 def seeds_study(card_path: Path, out: Path, seeds: list[int], *, cache: Path | None = None,

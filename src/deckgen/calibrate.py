@@ -984,10 +984,15 @@ def _with_split(summary: dict[str, Any], test_dir: Path) -> dict[str, Any]:
         return {**summary, "split_stress_Pa": math.nan, "bonds_broken_at_split": math.nan}
 
 
+def broken_fraction(summary: dict[str, Any], key: str = "bonds_broken_at_peak") -> float:
+    """Fraction of a test's initial bonds broken by the count ``key`` of its summary (NaN without bonds)."""
+    n = _num(summary.get("n_bonds_initial"))
+    return _num(summary.get(key)) / n if n > 0 else math.nan
+
+
 def broken_at_peak(summary: dict[str, Any]) -> float:
     """Fraction of a test's initial bonds broken at its peak stress (NaN without bonds)."""
-    n = _num(summary.get("n_bonds_initial"))
-    return _num(summary.get("bonds_broken_at_peak")) / n if n > 0 else math.nan
+    return broken_fraction(summary, "bonds_broken_at_peak")
 
 
 class DemEvaluator:
@@ -1006,6 +1011,9 @@ class DemEvaluator:
         if bts_reading not in ("peak", "split"):
             raise ValueError(f"bts_reading: {bts_reading!r} (fix: 'peak' or 'split')")
         self.bts_reading = bts_reading
+        # summary keys of the disc's strength and of its bonds broken there
+        self._bts_key, self._broken_key = {"peak": ("peak_stress_Pa", "bonds_broken_at_peak"),
+                                           "split": ("split_stress_Pa", "bonds_broken_at_split")}[bts_reading]
         self.base = base
         # replicate packings per test: the point's value is their mean (packing scatter of a coarse
         # Brazilian disc is ~12 %, more than the tolerance; docs/calibration.md)
@@ -1073,15 +1081,8 @@ class DemEvaluator:
             summary = folder / "parsed" / "summary.json"
             if not summary.is_file():
                 return math.nan
-            vals.append(self._broken(_with_split(json.loads(summary.read_text()), folder)))
+            vals.append(broken_fraction(_with_split(json.loads(summary.read_text()), folder), self._broken_key))
         return float(np.mean(vals))
-
-    def _broken(self, summary: dict[str, Any]) -> float:
-        """Fraction of a disc's bonds broken at the stress this evaluator reads as its strength."""
-        if self.bts_reading == "split":
-            n = _num(summary.get("n_bonds_initial"))
-            return _num(summary.get("bonds_broken_at_split")) / n if n > 0 else math.nan
-        return broken_at_peak(summary)
 
     def describe(self) -> dict[str, Any]:
         if self._engine is None:
@@ -1152,16 +1153,16 @@ class DemEvaluator:
             ucs = [d for (t, _), d in zip(jobs, done) if t == "ucs"]
             bts = [d for (t, _), d in zip(jobs, done) if t == "bts"]
             mean = lambda runs, k: float(np.mean([_num(r.get(k)) for r in runs]))  # noqa: E731
-            bkey = "split_stress_Pa" if self.bts_reading == "split" else "peak_stress_Pa"
+            bkey = self._bts_key
             out = {"ucs_Pa": mean(ucs, "peak_stress_Pa"), "bts_Pa": mean(bts, bkey),
                    "E_Pa": mean(ucs, "youngs_modulus_Pa"), "ok": True, "error": ""}
             # a peak far beyond the rock's UCS/E marks the ductile branch (docs/calibration.md, concrete run)
             out["ucs_strain_at_peak_1"] = mean(ucs, "strain_at_peak_1")
-            out["bts_broken_at_peak_1"] = float(np.mean([self._broken(r) for r in bts]))
+            broken = lambda key: float(np.mean([broken_fraction(r, key) for r in bts]))  # noqa: E731
+            out["bts_broken_at_peak_1"] = broken(self._broken_key)
             out["bts_peak_Pa"] = mean(bts, "peak_stress_Pa")
             out["bts_split_Pa"] = mean(bts, "split_stress_Pa")
-            out["bts_broken_at_split_1"] = float(np.mean([_num(r.get("bonds_broken_at_split")) / _num(r.get("n_bonds_initial"))
-                                                          for r in bts]))
+            out["bts_broken_at_split_1"] = broken("bonds_broken_at_split")
             if len(bts) > 1:
                 cv = lambda k: float(np.std([_num(r.get(k)) for r in bts], ddof=1) / mean(bts, k))  # noqa: E731
                 out["bts_cv_1"], out["bts_split_cv_1"] = cv(bkey), cv("split_stress_Pa")

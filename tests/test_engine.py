@@ -148,6 +148,66 @@ def test_runner_reports_lost_atoms(tmp_path):
         run_deck(tmp_path, command=engine_command(1), progress=False)
 
 
+_ENDLESS = ("units si\natom_style sphere\nboundary f f f\nregion b block 0 1 0 1 0 1 units box\ncreate_box 1 b\n"
+            "create_atoms 1 single 0.5 0.5 0.5 units box\nset atom 1 diameter 0.1 density 1000\npair_style zero 1.0\n"
+            "pair_coeff * *\nfix 1 all nve/sphere\ntimestep 1e-9\nthermo 1000000\nrun 2000000000\n")
+
+
+def _processes_in(folder: Path) -> list[int]:
+    """Pids of the processes whose working directory is ``folder`` (the engine's run folder)."""
+    pids = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                if Path(d / "cwd").resolve() == folder.resolve():
+                    pids.append(int(d.name))
+            except OSError:
+                continue
+    return pids
+
+
+def _wait_gone(folder: Path, seconds: float = 10.0) -> list[int]:
+    import time
+
+    t0 = time.time()
+    while _processes_in(folder) and time.time() - t0 < seconds:
+        time.sleep(0.2)
+    return _processes_in(folder)
+
+
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc to find the engine processes")
+def test_runner_timeout_stops_the_engine_binary_not_only_its_wrapper(tmp_path):
+    # the PyPI lmp is a Python wrapper that starts the real binary: killing the wrapper alone left the binary running
+    (tmp_path / "in.deck").write_text(_ENDLESS)
+    with pytest.raises(EngineError, match="exceeded 3 s"):
+        run_deck(tmp_path, command=engine_command(1), progress=False, timeout_s=3)
+    assert _wait_gone(tmp_path) == []
+
+
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc to find the engine processes")
+def test_sigterm_stops_the_running_engine(tmp_path):
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    (tmp_path / "in.deck").write_text(_ENDLESS)
+    script = ("import sys\nfrom deckgen.runner import engine_command, run_deck, stop_engines_on_sigterm\n"
+              "stop_engines_on_sigterm()\n"
+              f"run_deck({str(tmp_path)!r}, command=engine_command(1), progress=False)\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], stderr=subprocess.PIPE, text=True)
+    t0 = time.time()
+    while not (tmp_path / "log.lammps").exists() and time.time() - t0 < 60:
+        time.sleep(0.2)
+    time.sleep(1.0)
+    assert len(_processes_in(tmp_path)) >= 1  # the engine is running
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 128 + signal.SIGTERM, err
+    assert "1 running engine(s) stopped" in err
+    assert _wait_gone(tmp_path) == []
+
+
 def test_cli_render_and_stl(tmp_path, cache, capsys):
     from deckgen.cli import main
 

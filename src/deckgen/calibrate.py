@@ -1653,8 +1653,9 @@ def run_card(card_path: str | Path, out: str | Path, *, cache: str | Path | None
 def main(argv: list[str] | None = None) -> int:
     import shlex
 
-    from deckgen.runner import engine_command
+    from deckgen.runner import engine_command, stop_engines_on_sigterm
 
+    stop_engines_on_sigterm()
     ap = argparse.ArgumentParser(prog="python -m deckgen.calibrate", description=(
         "Calibrate bond micro-parameters to a material card's UCS, BTS and E (resumable: evaluations "
         "recorded in OUT/evaluations.csv are replayed)."))

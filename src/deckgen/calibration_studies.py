@@ -546,8 +546,9 @@ def results_table(cards: list[Path], studies: Path) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from deckgen.runner import engine_command
+    from deckgen.runner import engine_command, stop_engines_on_sigterm
 
+    stop_engines_on_sigterm()
     ap = argparse.ArgumentParser(prog="python -m deckgen.calibration_studies", description=__doc__.split("\n\n")[0])
     ap.add_argument("study", choices=["ratio", "quasistatic", "seeds", "table"])
     ap.add_argument("cards", nargs="*", help="calibrated material cards (quasistatic, seeds, table)")

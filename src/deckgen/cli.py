@@ -277,9 +277,10 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     from deckgen.parse.common import ParseError
     from deckgen.render import DeckError
-    from deckgen.runner import EngineError
+    from deckgen.runner import EngineError, stop_engines_on_sigterm
     from deckgen.spec import SpecError
 
+    stop_engines_on_sigterm()
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)

@@ -1194,6 +1194,9 @@ def _root(arg: str | None) -> Path:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from deckgen.runner import stop_engines_on_sigterm
+
+    stop_engines_on_sigterm()
     p = argparse.ArgumentParser(prog="python -m deckgen.families", description=__doc__.split("\n\n")[0])
     p.add_argument("command", choices=["write", "check", "list", "report", "combine"],
                    help="combine: the report of family tables made apart (e.g. later replicate runs), given as arguments")

@@ -12,8 +12,10 @@ import json
 import os
 import re
 import shlex
+import signal
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -120,6 +122,51 @@ def _stderr_tail(run_dir: Path) -> list[str]:
     return [ln for ln in lines if "mca_base_component_repository_open" not in ln][-3:]
 
 
+# Engines started by run_deck and still running. Each runs in its own process group: the PyPI ``lmp`` is a Python
+# wrapper that starts the real binary as its child, and ``mpirun`` starts one child per rank, so killing the
+# launched process alone would leave the engine computing on (it did: a stopped calibration kept its lmp running).
+_LIVE: set[subprocess.Popen] = set()
+_LIVE_LOCK = threading.Lock()
+_STOPPING = threading.Event()  # set by the SIGTERM handler: no new engine starts (a worker thread may try)
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    """Kill ``proc`` and every process of its group (the engine binary behind a wrapper, the MPI ranks)."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    try:
+        proc.kill()
+    except ProcessLookupError:
+        pass
+    proc.wait()
+
+
+def stop_engines() -> int:
+    """Kill every engine run_deck has started and that is still running; returns how many were killed."""
+    with _LIVE_LOCK:
+        live = [p for p in _LIVE if p.poll() is None]
+    for proc in live:
+        _kill_group(proc)
+    return len(live)
+
+
+def stop_engines_on_sigterm() -> None:
+    """Install a SIGTERM handler (main thread only) that kills the running engines and exits with 143, as a
+    ``kill`` from a scheduler or a user expects; Python's default would exit without running any cleanup."""
+    if threading.current_thread() is not threading.main_thread():
+        return
+
+    def handler(signum: int, frame: object) -> None:
+        _STOPPING.set()
+        n = stop_engines()
+        print(f"deckgen: terminated (signal {signum}); {n} running engine(s) stopped", file=sys.stderr)
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, handler)
+
+
 def _deck_max_ranks(run_dir: Path) -> int | None:
     """``derived.max_ranks`` of the run folder's spec.json (written for decks with a serial style), else None."""
     spec = run_dir / "spec.json"
@@ -148,6 +195,8 @@ def run_deck(
     run_dir = Path(run_dir)
     if not (run_dir / deck).is_file():
         raise EngineError(f"{run_dir / deck}: deck not found (fix: render it first)")
+    if _STOPPING.is_set():
+        raise EngineError(f"{run_dir / deck}: not started, deckgen is terminating")
     cmd = list(command) if command else engine_command()
     max_ranks = _deck_max_ranks(run_dir)
     if max_ranks is not None:
@@ -168,7 +217,10 @@ def run_deck(
                    mininterval=1.0, file=sys.stderr, leave=False)
     t0 = time.perf_counter()
     with open(run_dir / "engine.stdout", "w") as out, open(run_dir / "engine.stderr", "w") as err:
-        proc = subprocess.Popen(argv, cwd=run_dir, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=engine_env())
+        proc = subprocess.Popen(argv, cwd=run_dir, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=engine_env(),
+                                start_new_session=True)
+        with _LIVE_LOCK:
+            _LIVE.add(proc)
         last, fh = 0, None
         try:
             while proc.poll() is None:
@@ -182,15 +234,17 @@ def run_deck(
                             bar.update(new - last)
                             last = new
                 if timeout_s and time.perf_counter() - t0 > timeout_s:
-                    proc.kill()
+                    _kill_group(proc)
                     raise EngineError(f"{run_dir / deck}: engine exceeded {timeout_s:.0f} s and was stopped")
         finally:
             if fh is not None:
                 fh.close()
             if bar is not None:
                 bar.close()
-            if proc.poll() is None:
-                proc.kill()
+            if proc.poll() is None:  # interrupted (Ctrl-C, SIGTERM, an error above): no engine left behind
+                _kill_group(proc)
+            with _LIVE_LOCK:
+                _LIVE.discard(proc)
     wall = time.perf_counter() - t0
     if not logpath.exists():
         tail = _stderr_tail(run_dir)

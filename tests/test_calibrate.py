@@ -581,3 +581,36 @@ def test_a_calibrated_card_calibrates_on_its_setup_base_not_on_its_result():
     ucs, bts = quasi_static_specimens(card)
     keys = {DemEvaluator(b, ucs, bts, "unused").setup_key for b in (setup_base(card), setup_base(bare))}
     assert len(keys) == 1
+
+
+def test_an_inactive_crushing_penalty_does_not_shrink_the_step(tmp_path):
+    """A model that is exactly the split prior (log-linear) and whose discs always split (5 % broken): the first
+    step is the Gauss-Newton step and lands on the targets. With the penalty's prior row kept while the penalty was
+    inactive, the first step moved sigma_c +3 % instead of +18 % (the fine-sandstone calibration, session 16)."""
+    from deckgen.calibrate import SPLIT_PRIOR, prior_jacobian
+
+    card = _card("sandstone")
+    space = ParameterSpace(["log_E_b", "log_sigma_c", "log_tau_ratio"])
+    J = prior_jacobian(space, "flat_joint_split")
+    start = MicroParams(youngs_modulus_GPa=15.1468, tensile_strength_MPa=5.75284, shear_strength_MPa=32.139,
+                        gap_tolerance=0.4, contact_modulus_ratio=4.0, flat_joint=1, joint_friction=1.0,
+                        moment_contribution=0.0)
+    x0 = space.to_vector(start)
+    t = card.targets.as_pa()
+    r0 = np.log([1.133, 0.835, 1.069])  # the fine sandstone's first evaluation: +13.3 %, -16.5 %, +6.9 %
+
+    class Linear:
+        measures_split = True
+        bts_reading = "split"
+
+        def evaluate(self, p):
+            r = r0 + J @ (space.to_vector(p) - x0)
+            return {"ok": True, "ucs_Pa": t["ucs"] * math.exp(r[0]), "bts_Pa": t["bts"] * math.exp(r[1]),
+                    "E_Pa": t["E"] * math.exp(r[2]), "bts_broken_at_peak_1": 0.05}
+
+    assert set(SPLIT_PRIOR) >= set(space.names)  # the penalty row has entries in every moving parameter
+    res = calibrate(Linear(), card.targets, start, tmp_path / "t.csv", max_evals=6, space=space, prior=J,
+                    bts_max_broken=0.2)
+    assert res.converged and len(res.evaluations) == 2
+    step = res.best.params.tensile_strength_MPa / start.tensile_strength_MPa - 1
+    assert step == pytest.approx(0.18, abs=0.02)  # trf's first step: most of the Gauss-Newton +19.6 %

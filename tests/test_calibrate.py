@@ -614,3 +614,37 @@ def test_an_inactive_crushing_penalty_does_not_shrink_the_step(tmp_path):
     assert res.converged and len(res.evaluations) == 2
     step = res.best.params.tensile_strength_MPa / start.tensile_strength_MPa - 1
     assert step == pytest.approx(0.18, abs=0.02)  # trf's first step: most of the Gauss-Newton +19.6 %
+
+
+def test_resolution_table_orders_by_grain_size_and_gives_ratios_to_the_coarse_card(tmp_path):
+    from deckgen.calibrate import write_card
+    from deckgen.calibration_studies import resolution_table
+
+    coarse = _card("sandstone")
+    bonds = {**coarse.calibrated.bonds, "youngs_modulus_GPa": coarse.calibrated.bonds["youngs_modulus_GPa"] * 1.1}
+    fine = coarse.model_copy(update={
+        "calibrated": coarse.calibrated.model_copy(update={"bonds": bonds}),
+        "provenance": coarse.provenance.model_copy(update={"radius_min_mm": 0.6, "radius_max_mm": 1.0})})
+    write_card(fine, tmp_path / "fine.yaml")
+    text = resolution_table([tmp_path / "fine.yaml", MATERIALS / "sandstone.yaml"])  # fine given first
+    rows = [ln for ln in text.splitlines() if ln.startswith("| sandstone")]
+    assert len(rows) == 2
+    assert rows[0].startswith("| sandstone | 0.8-1.333 | 7.5 | 9.4 |") and "(×1.000)" in rows[0]
+    assert rows[1].startswith("| sandstone | 0.6-1 | 10.0 | 12.5 |")
+    assert f"{bonds['youngs_modulus_GPa']:.4g} (×1.100)" in rows[1] and rows[1].count("(×1.000)") == 2
+    bare = fine.model_copy(update={"provenance": fine.provenance.model_copy(update={"radius_min_mm": None})})
+    write_card(bare, tmp_path / "bare.yaml")
+    with pytest.raises(CardError, match="radius_min_mm.*fix: re-run"):
+        resolution_table([tmp_path / "bare.yaml"])
+
+
+def test_analytic_start_leaves_fixed_fields_at_their_defaults():
+    """Only the optimiser's parameters are moved inside their bounds: the twisting factor's bound is its default 1,
+    and a margin on it put twisting_strength_factor 1.0009 into every start's key and deck."""
+    for table in ("ratio", "high_strain"):
+        p = analytic_start(_card("savonniere_limestone").targets, table=table)
+        assert p.twisting_strength_factor == 1.0 and p.bending_strength_factor == 1.0
+        assert "twisting" not in json.dumps(p.overrides())
+    space = ParameterSpace(["log_E_b", "log_sigma_c", "log_twisting_factor"])
+    p = analytic_start(_card("savonniere_limestone").targets, space=space)
+    assert 1.0 < p.twisting_strength_factor < 1.01  # free: strictly inside its bounds for least_squares

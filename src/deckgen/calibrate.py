@@ -760,10 +760,7 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         p = _start_flat_joint(t, base, sp, split=table == "flat_joint_split")
         return sp.from_vector(sp.clip_inside(sp.to_vector(p), 1e-3), p)
     if table == "high_strain":
-        p = _start_high_strain(t, base, sp)
-        bounds = {n: (float(lo), float(hi)) for n, lo, hi in zip(sp.names, sp.lo, sp.hi)}
-        full = ParameterSpace(PARAM_NAMES, bounds=bounds)
-        return full.from_vector(full.clip_inside(full.to_vector(p), 1e-3), p)
+        return _clip_start(_start_high_strain(t, base, sp), sp)
     want = math.log(t.ucs_MPa / t.bts_MPa)
 
     def log_ratio(g: float, r: float) -> float:
@@ -793,8 +790,20 @@ def analytic_start(targets: CardTargets, base_case: Case | dict[str, Any] | None
         friction=base.contact.friction, rolling_friction=base.contact.rolling_friction,
         radius_multiplier=base.bonds.radius_multiplier, gap_tolerance=g,
     )
-    full = ParameterSpace(PARAM_NAMES)
-    return full.from_vector(full.clip_inside(full.to_vector(p), 1e-3), p)
+    return _clip_start(p, sp)
+
+
+def _clip_start(p: MicroParams, sp: ParameterSpace) -> MicroParams:
+    """``p`` inside the bounds of every parameter (those of ``sp`` where it sets them): the optimiser's parameters a
+    little inside (least_squares needs a strictly feasible start), the others onto the bound at most. Moving a fixed
+    field inside its bound would change the model: the twisting factor's bound is its default 1, and a margin made
+    every start carry twisting_strength_factor 1.0009 into its keys, decks and card."""
+    bounds = {n: (float(lo), float(hi)) for n, lo, hi in zip(sp.names, sp.lo, sp.hi)}
+    full = ParameterSpace(PARAM_NAMES, bounds=bounds)
+    x = np.clip(full.to_vector(p), full.lo, full.hi)
+    inside = full.clip_inside(x, 1e-3)
+    free = np.array([n in sp.names for n in full.names])
+    return full.from_vector(np.where(free, inside, x), p)
 
 
 def _prior_high_strain(space: ParameterSpace) -> np.ndarray:

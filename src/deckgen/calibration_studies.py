@@ -10,6 +10,8 @@
 - ``seeds``: a calibrated card re-run on new packing seeds: mean, standard deviation and coefficient
   of variation of UCS, BTS and E.
 - ``table``: the per-rock results table (markdown) from the calibrated cards and the seed studies.
+- ``resolution``: calibrated cards of one rock at several grain sizes side by side (markdown): how the
+  calibrated micro-parameters move with the particle size (issue #3, item 6).
 
 Every study writes ``<out>/<study>.csv`` (one row per virtual test pair) and ``<out>/<study>.md``; the
 engine runs live under ``<out>/work/`` and are answered from disk when repeated (like the calibration).
@@ -545,13 +547,59 @@ def results_table(cards: list[Path], studies: Path) -> str:
     return head + "\n".join(lines) + "\n"
 
 
+def _grain_radii_mm(card: Any) -> tuple[float, float]:
+    """(r_min, r_max) of the packing a calibrated card was calibrated on (its provenance), mm."""
+    pv = card.provenance
+    if pv is None or pv.radius_min_mm is None or pv.radius_max_mm is None:
+        raise CardError(f"{card.rock}: provenance.radius_min_mm/radius_max_mm: missing (fix: re-run "
+                        f"python -m deckgen.calibrate on the card, which records them)")
+    return float(pv.radius_min_mm), float(pv.radius_max_mm)
+
+
+def resolution_table(cards: list[Path]) -> str:
+    """Markdown table: calibrated cards of the same rock at different grain sizes, coarsest first per rock, with
+    each micro-parameter also as a ratio to the coarsest card's (issue #3, item 6: how the micro-parameters move
+    with the particle size). D/d is the specimen diameter over the mean grain diameter r_min + r_max."""
+    head = ("| rock | grain radii mm | UCS D/d | BTS D/d | bond law | evaluations | UCS (err) | BTS (err) | E (err) "
+            "| E_b GPa (× coarse) | σ_c MPa (× coarse) | τ_c MPa (× coarse) | τ_c/σ_c | g |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    groups: dict[str, list[Any]] = {}
+    for path in cards:
+        card = load_card(path)
+        if card.calibrated is None or card.provenance is None:
+            raise CardError(f"{path}: calibrated: missing (fix: give calibrated cards; run python -m deckgen.calibrate)")
+        groups.setdefault(card.rock, []).append(card)
+    lines = []
+    for rock, group in groups.items():
+        group.sort(key=lambda c: sum(_grain_radii_mm(c)), reverse=True)
+        ref = group[0].calibrated.bonds
+        for card in group:
+            b, a, pv = card.calibrated.bonds, card.provenance.achieved, card.provenance
+            r_min, r_max = _grain_radii_mm(card)
+            d = r_min + r_max  # the mean grain diameter of uniform radii
+            u, t = quasi_static_specimens(card)
+
+            def cell(key: str) -> str:
+                return f"{b[key]:.4g} (×{b[key] / ref[key]:.3f})"
+
+            lines.append(
+                f"| {rock} | {r_min:g}-{r_max:g} | {u['diameter_mm'] / d:.1f} | "
+                f"{t['diameter_mm'] / d:.1f} | {_bond_law(b)}, BTS at {pv.bts_reading} | "
+                f"{pv.evaluations}{'' if pv.converged else ' (not converged)'} | "
+                f"{a.ucs_MPa:.4g} ({a.ucs_error:+.1%}) | {a.bts_MPa:.4g} ({a.bts_error:+.1%}) | "
+                f"{a.youngs_modulus_GPa:.4g} ({a.youngs_modulus_error:+.1%}) | {cell('youngs_modulus_GPa')} | "
+                f"{cell('tensile_strength_MPa')} | {cell('shear_strength_MPa')} | "
+                f"{b['shear_strength_MPa'] / b['tensile_strength_MPa']:.3g} | {b.get('gap_tolerance', 0.05):.3g} |")
+    return head + "\n".join(lines) + "\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     from deckgen.runner import engine_command, stop_engines_on_sigterm
 
     stop_engines_on_sigterm()
     ap = argparse.ArgumentParser(prog="python -m deckgen.calibration_studies", description=__doc__.split("\n\n")[0])
-    ap.add_argument("study", choices=["ratio", "quasistatic", "seeds", "table"])
-    ap.add_argument("cards", nargs="*", help="calibrated material cards (quasistatic, seeds, table)")
+    ap.add_argument("study", choices=["ratio", "quasistatic", "seeds", "table", "resolution"])
+    ap.add_argument("cards", nargs="*", help="calibrated material cards (quasistatic, seeds, table, resolution)")
     ap.add_argument("--out", default="results/calibration/studies", help="output folder")
     ap.add_argument("--cache", default=None, help="packing cache")
     ap.add_argument("--seeds", default="101,202,303,404,505", help="seeds study: comma-separated packing seeds")
@@ -559,7 +607,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--engine-cmd", default=None, help="engine command line")
     ap.add_argument("--jobs", type=int, choices=[1, 2], default=1,
                     help="2: run the UCS and BTS tests of a point at the same time (1 rank each unless --ranks)")
-    ap.add_argument("--write", default=None, help="table: also write the markdown here")
+    ap.add_argument("--write", default=None, help="table, resolution: also write the markdown here")
     ap.add_argument("--set", dest="variant_set", default="default", choices=sorted(RATIO_SETS),
                     help="ratio: variant set (high-strain: sigma_c/E_b 3e-3, g 0.4, E_c/E_b 4)")
     ap.add_argument("--card", default=None, help="ratio: take the base case and the quasi-static specimens from "
@@ -592,8 +640,11 @@ def main(argv: list[str] | None = None) -> int:
                 bts = {**bts, "stop_fraction_of_peak": a.bts_stop}
             print(ratio_study(out, base=base, ucs=ucs, bts=bts, cache=cache, command=command, parallel=par,
                               variant_set=a.variant_set, only=only, bts_packings=a.bts_packings).to_string())
-        elif a.study == "table":
-            text = results_table([Path(c) for c in a.cards], out)
+        elif a.study in ("table", "resolution"):
+            if a.study == "resolution" and not a.cards:
+                ap.error("resolution: give the calibrated cards of a rock at its grain sizes")
+            paths = [Path(c) for c in a.cards]
+            text = results_table(paths, out) if a.study == "table" else resolution_table(paths)
             print(text)
             if a.write:
                 Path(a.write).write_text(text)

@@ -411,21 +411,26 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
 
 
 def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
-                      command: list[str] | None = None, parallel: bool = False) -> pd.DataFrame:
+                      command: list[str] | None = None, parallel: bool = False,
+                      ucs_packings: int | None = None, bts_packings: int | None = None) -> pd.DataFrame:
     """The calibrated point at the card's platen speeds and at half of them (same replicate packings
-    as the calibration's evaluations, so the full-speed row reproduces the card's achieved values)."""
+    as the calibration's evaluations, so the full-speed row reproduces the card's achieved values).
+    ``ucs_packings``/``bts_packings`` (default: the card's) average more specimens, the calibration's first: the
+    change at half speed is a paired difference whose noise falls with the number of specimens."""
     card, p, base, ucs, bts = _card_setup(card_path)
+    n_ucs = ucs_packings or card.calibration.ucs_packings
+    n_bts = bts_packings or card.calibration.bts_packings
     rows = []
     for factor in (1.0, 0.5):
         u = {**ucs, "platen_speed_m_s": ucs["platen_speed_m_s"] * factor}
         b = {**bts, "platen_speed_m_s": bts["platen_speed_m_s"] * factor}
         # the calibration's own evaluation (its replicate packings), at full and half speed
         ev = DemEvaluator(base, u, b, out / "work" / f"speed_{factor:g}", cache=cache, command=command, name=card.rock,
-                          parallel=parallel, ucs_packings=card.calibration.ucs_packings,
-                          bts_packings=card.calibration.bts_packings, bts_reading=card.calibration.bts_reading)
+                          parallel=parallel, ucs_packings=n_ucs, bts_packings=n_bts,
+                          bts_reading=card.calibration.bts_reading)
         row = _row(f"speed x{factor:g}", ev, p)
         row.update({"rock": card.rock, "speed_factor": factor, "ucs_speed_m_s": u["platen_speed_m_s"],
-                    "bts_speed_m_s": b["platen_speed_m_s"]})
+                    "bts_speed_m_s": b["platen_speed_m_s"], "ucs_packings": n_ucs, "bts_packings": n_bts})
         rows.append(row)
         if factor == 1.0 and row["ok"]:  # failure patterns of the calibrated point (issue #3: a snapshot per test)
             failure_snapshots(ev, p, out / f"plots_{card.rock}")
@@ -434,7 +439,7 @@ def quasistatic_study(card_path: Path, out: Path, *, cache: Path | None = None,
         df[f"{k.removesuffix('_Pa')}_change_at_half_speed_1"] = df[k] / df[k].iloc[0] - 1.0
     return _write(df.to_dict("records"), out, f"quasistatic_{card.rock}",
                   f"Quasi-static check, {card.rock} (deckgen.calibration_studies quasistatic)",
-                  ["variant", "ucs_speed_m_s", "bts_speed_m_s", "ucs_Pa", "bts_Pa", "E_Pa",
+                  ["variant", "ucs_packings", "bts_packings", "ucs_speed_m_s", "bts_speed_m_s", "ucs_Pa", "bts_Pa", "E_Pa",
                    "ucs_change_at_half_speed_1", "bts_change_at_half_speed_1", "E_change_at_half_speed_1"])
 
 
@@ -615,7 +620,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", action="append", default=None,
                     help="ratio: run the variants whose label starts with this prefix; repeat it for several (labels "
                          "hold commas, so a prefix is taken whole)")
-    ap.add_argument("--bts-packings", type=int, default=1, help="ratio: BTS discs (packing seeds) per variant, averaged")
+    ap.add_argument("--bts-packings", type=int, default=None,
+                    help="ratio: BTS discs (packing seeds) per variant, averaged (default 1); quasistatic: per speed "
+                         "(default: the card's)")
+    ap.add_argument("--ucs-packings", type=int, default=None, help="quasistatic: UCS cylinders per speed (default: the card's)")
     ap.add_argument("--ucs-stop", type=float, default=None, help="ratio: UCS stop_fraction_of_peak (default: the specimen's)")
     ap.add_argument("--bts-stop", type=float, default=None, help="ratio: BTS stop_fraction_of_peak (default: the specimen's)")
     a = ap.parse_args(argv)
@@ -639,7 +647,7 @@ def main(argv: list[str] | None = None) -> int:
             if a.bts_stop is not None:
                 bts = {**bts, "stop_fraction_of_peak": a.bts_stop}
             print(ratio_study(out, base=base, ucs=ucs, bts=bts, cache=cache, command=command, parallel=par,
-                              variant_set=a.variant_set, only=only, bts_packings=a.bts_packings).to_string())
+                              variant_set=a.variant_set, only=only, bts_packings=a.bts_packings or 1).to_string())
         elif a.study in ("table", "resolution"):
             if a.study == "resolution" and not a.cards:
                 ap.error("resolution: give the calibrated cards of a rock at its grain sizes")
@@ -653,7 +661,8 @@ def main(argv: list[str] | None = None) -> int:
                 ap.error(f"{a.study}: give at least one calibrated card")
             for c in a.cards:
                 if a.study == "quasistatic":
-                    print(quasistatic_study(Path(c), out, cache=cache, command=command, parallel=par).to_string())
+                    print(quasistatic_study(Path(c), out, cache=cache, command=command, parallel=par,
+                                            ucs_packings=a.ucs_packings, bts_packings=a.bts_packings).to_string())
                 else:
                     seeds = [int(s) for s in a.seeds.split(",") if s.strip()]
                     df = seeds_study(Path(c), out, seeds, cache=cache, command=command, parallel=par)

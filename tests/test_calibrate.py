@@ -648,3 +648,19 @@ def test_analytic_start_leaves_fixed_fields_at_their_defaults():
     space = ParameterSpace(["log_E_b", "log_sigma_c", "log_twisting_factor"])
     p = analytic_start(_card("savonniere_limestone").targets, space=space)
     assert 1.0 < p.twisting_strength_factor < 1.01  # free: strictly inside its bounds for least_squares
+
+
+def test_fine_setups_are_the_recorded_resolution_calibrations():
+    """cases/materials/fine/<rock>.yaml is what docs/calibration_runs/<rock>_fine_card.yaml was calibrated from, and
+    differs from the rock's card only in the grain size (and the start and budget)."""
+    for path in sorted((MATERIALS / "fine").glob("*.yaml")):
+        setup = load_card(path)
+        recorded = load_card(ROOT / "docs" / "calibration_runs" / f"{setup.rock}_fine_card.yaml")
+        assert setup.calibrated is None and setup.calibration == recorded.calibration
+        coarse = _card(setup.rock)
+        assert setup.targets == coarse.targets
+        same = {"start", "max_evals", "base"}
+        assert setup.calibration.model_dump(exclude=same) == coarse.calibration.model_dump(exclude=same)
+        fine_r, coarse_r = setup.calibration.base["packing"], coarse.calibration.base["packing"]
+        assert fine_r["radius_max_mm"] < coarse_r["radius_max_mm"]
+        assert recorded.provenance.radius_max_mm == fine_r["radius_max_mm"] and recorded.provenance.converged

@@ -32,3 +32,12 @@ def test_lint_is_clean():
     res = _snakemake("--lint")
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-2000:]
     assert "Congratulations, your workflow is in a good condition" in res.stdout + res.stderr
+
+
+def test_dry_run_plans_the_resolution_study(tmp_path):
+    res = _snakemake("-n", f"{tmp_path}/results/calibration/resolution_sandstone.md", "--config",
+                     f"results={tmp_path / 'results'}")
+    assert res.returncode == 0, res.stderr[-2000:]
+    text = " ".join((res.stdout + res.stderr).split())
+    for rule in ("calibrate 1", "calibrate_fine 1", "calibration_resolution 1"):
+        assert rule in text, (rule, text[-1500:])

@@ -91,3 +91,41 @@ rule calibration_table:
 rule calibration_report:
     input:
         f"{RESULTS}/calibration/table.md",
+
+
+# resolution (issue #3, item 6): a rock's calibration set-up at finer grains, cases/materials/fine/<rock>.yaml,
+# calibrated like the card and tabled beside it (how the micro-parameters move with the grain size):
+#   snakemake --cores 2 results/calibration/resolution_sandstone.md
+rule calibrate_fine:
+    input:
+        targets="cases/materials/fine/{rock}.yaml",
+    output:
+        card=f"{RESULTS}/calibration/fine/{{rock}}/card.yaml",
+    conda:
+        "../envs/deckgen.yaml"
+    log:
+        f"{RESULTS}/logs/calibrate_fine/{{rock}}.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/calibrate_fine/{{rock}}.tsv"
+    threads: config.get("ranks", 2)
+    params:
+        out=lambda w, output: str(Path(output.card).parent),
+        cache=f"{RESULTS}/.cache",
+        engine=calib_engine_args(),
+    shell:
+        "python -m deckgen.calibrate {input.targets} --out {params.out} --cache {params.cache} "
+        "{params.engine} > {log} 2>&1"
+
+
+rule calibration_resolution:
+    input:
+        coarse=f"{RESULTS}/calibration/{{rock}}/card.yaml",
+        fine=f"{RESULTS}/calibration/fine/{{rock}}/card.yaml",
+    output:
+        f"{RESULTS}/calibration/resolution_{{rock}}.md",
+    log:
+        f"{RESULTS}/logs/calibration_resolution/{{rock}}.log",
+    conda:
+        "../envs/deckgen.yaml"
+    shell:
+        "python -m deckgen.calibration_studies resolution {input.coarse} {input.fine} --write {output} > {log} 2>&1"

@@ -576,6 +576,9 @@ def test_split_reads_the_stress_when_a_diametral_crack_has_broken_not_the_crushi
     assert r["split_strain_1"] == pytest.approx(0.004, abs=5e-5)
     assert 10 + 96 <= r["bonds_broken_at_split"] <= 10 + 100  # the far-off early ones and (nearly) the whole crack
     assert 96 / 110 <= r["split_localisation_1"] <= 96 / 106  # bonds breaking in the same step as the 96th count
+    i = int(np.argmin(np.abs(ts["strain_1"].to_numpy() - r["split_strain_1"])))
+    assert r["split_step"] == int(ts["step"].iloc[i]) and r["bonds_broken_at_split"] == int(ts["bonds_broken"].iloc[i])
+    assert (r["split_band_x_m"], r["split_band_z_m"]) == pytest.approx((0.0, 0.01))  # jaw x, midway between the jaws
 
 
 @pytest.mark.parametrize("why, kw", [
@@ -608,4 +611,6 @@ def test_split_map_marks_the_bonds_broken_by_the_split(tmp_path):
     s = {"case": "synthetic", "test": "bts", "engine": "lammps", "height_m": 0.02, **split_onset(ts, broken, spec)}
     png = _split_map(s, ts, broken, tmp_path / "split.png")
     assert png is not None and png.stat().st_size > 10_000 and png.read_bytes()[:4] == b"\x89PNG"
+    old = {k: v for k, v in s.items() if k not in ("split_step", "split_band_x_m", "split_band_z_m")}
+    assert _split_map(old, ts, broken, tmp_path / "old.png") is not None  # a summary from before those keys
     assert _split_map(s, ts, broken.iloc[0:0], tmp_path / "none.png") is None

@@ -190,8 +190,11 @@ def _split_map(summary: dict[str, Any], ts: pd.DataFrame, broken: pd.DataFrame, 
 
     if broken.empty or not _finite(summary.get("split_strain_1")):
         return None
-    i = int(np.argmin(np.abs(ts["strain_1"].to_numpy(dtype=float) - float(summary["split_strain_1"]))))
-    at = int(ts["step"].iloc[i])
+    if summary.get("split_step") is not None:
+        at = int(summary["split_step"])
+    else:  # a summary written before split_step: the sample nearest its strain
+        i = int(np.argmin(np.abs(ts["strain_1"].to_numpy(dtype=float) - float(summary["split_strain_1"]))))
+        at = int(ts["step"].iloc[i])
     early = broken["step"].to_numpy() <= at
     fig = Figure(figsize=(6.5, 6.0), dpi=120, layout="constrained")
     FigureCanvasAgg(fig)
@@ -199,13 +202,15 @@ def _split_map(summary: dict[str, Any], ts: pd.DataFrame, broken: pd.DataFrame, 
     x, z = broken["x_m"].to_numpy() * 1e3, broken["z_m"].to_numpy() * 1e3
     ax.plot(x[~early], z[~early], ".", color="0.75", ms=4, label=f"broken after ({int((~early).sum())})")
     ax.plot(x[early], z[early], ".", color="tab:red", ms=5, label=f"broken by the split ({int(early.sum())})")
-    R = 0.5 * float(summary.get("height_m", np.nan)) * 1e3  # the disc stands on z = 0, centred on x = 0
+    R = 0.5 * float(summary.get("height_m", np.nan)) * 1e3
     if np.isfinite(R):
-        zc = R
-        ax.add_patch(Rectangle((-SPLIT_BAND * R, zc - SPLIT_CORE * R), 2 * SPLIT_BAND * R, 2 * SPLIT_CORE * R,
+        # the band split_onset counted (older summaries: the disc standing on z = 0, loaded along x = 0)
+        xc = 1e3 * float(summary["split_band_x_m"]) if _finite(summary.get("split_band_x_m")) else 0.0
+        zc = 1e3 * float(summary["split_band_z_m"]) if _finite(summary.get("split_band_z_m")) else R
+        ax.add_patch(Rectangle((xc - SPLIT_BAND * R, zc - SPLIT_CORE * R), 2 * SPLIT_BAND * R, 2 * SPLIT_CORE * R,
                                fill=False, ls="--", color="tab:green", label="counted band"))
         t = np.linspace(0, 2 * np.pi, 200)
-        ax.plot(R * np.cos(t), zc + R * np.sin(t), color="black", lw=0.8)
+        ax.plot(xc + R * np.cos(t), zc + R * np.sin(t), color="black", lw=0.8)
     ax.set_aspect("equal")
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("z (mm)")

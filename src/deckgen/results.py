@@ -663,12 +663,14 @@ def split_onset(ts: pd.DataFrame, broken: pd.DataFrame, spec: dict[str, Any]) ->
     ``split_stress_Pa`` is the largest stress up to that sample, or the peak when the count is reached after the
     peak or never (a brittle disc splits at its peak and cracks through after it: ``split_source`` "peak";
     otherwise "crack"). Always ``split_stress_Pa <= peak_stress_Pa``. Also ``split_crack_bonds`` (the count
-    needed), ``split_localisation_1`` (that count over all bonds broken by then: ~0.85 for a diametral crack) and
-    ``bonds_broken_at_split``.
+    needed), ``split_localisation_1`` (that count over all bonds broken by then: ~0.85 for a diametral crack),
+    ``bonds_broken_at_split``, ``split_step`` (the step of the reading's sample) and the counted band's centre
+    ``split_band_x_m``, ``split_band_z_m``.
     """
     nan = _nan()
     out: dict[str, Any] = {"split_stress_Pa": nan, "split_strain_1": nan, "bonds_broken_at_split": nan,
-                           "split_crack_bonds": nan, "split_localisation_1": nan, "split_source": "none"}
+                           "split_crack_bonds": nan, "split_localisation_1": nan, "split_source": "none",
+                           "split_step": None, "split_band_x_m": nan, "split_band_z_m": nan}
     if ts.empty:
         return out
     stress = ts["stress_Pa"].to_numpy(dtype=float)
@@ -689,7 +691,7 @@ def split_onset(ts: pd.DataFrame, broken: pd.DataFrame, spec: dict[str, Any]) ->
     z_c = (0.5 * (float(jaws["zc_bot"]) + float(jaws["zc_top"])) if {"zc_bot", "zc_top"} <= set(jaws)
            else 0.5 * float(derived.get("height_m", 2.0 * R)))
     need = SPLIT_CRACK_SHARE * n0 * bond_len / (math.pi * R) if R > 0 else nan
-    out["split_crack_bonds"] = need
+    out.update(split_crack_bonds=need, split_band_x_m=x_load, split_band_z_m=z_c)  # the counted band's centre
     if len(broken) and math.isfinite(need) and need > 0:
         on_diameter = ((np.abs(broken["x_m"].to_numpy(dtype=float) - x_load) < SPLIT_BAND * R)
                        & (np.abs(broken["z_m"].to_numpy(dtype=float) - z_c) < SPLIT_CORE * R))
@@ -705,7 +707,7 @@ def split_onset(ts: pd.DataFrame, broken: pd.DataFrame, spec: dict[str, Any]) ->
     if out["split_source"] == "none":
         out["split_source"] = "peak"
     out.update(split_stress_Pa=float(stress[stop]), split_strain_1=float(ts["strain_1"].iloc[stop]),
-               bonds_broken_at_split=int(bb[stop]))
+               bonds_broken_at_split=int(bb[stop]), split_step=int(steps[stop]))
     return out
 
 

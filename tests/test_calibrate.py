@@ -664,3 +664,13 @@ def test_fine_setups_are_the_recorded_resolution_calibrations():
         fine_r, coarse_r = setup.calibration.base["packing"], coarse.calibration.base["packing"]
         assert fine_r["radius_max_mm"] < coarse_r["radius_max_mm"]
         assert recorded.provenance.radius_max_mm == fine_r["radius_max_mm"] and recorded.provenance.converged
+
+
+def test_study_point_of_a_flat_joint_card_carries_its_bond_law():
+    from deckgen.calibration_studies import _card_setup
+
+    _, p, base, _, _ = _card_setup(MATERIALS / "sandstone.yaml")
+    assert (p.flat_joint, p.joint_friction, p.moment_contribution) == (1, 1.0, 0.0)
+    assert p.overrides()["bonds"]["model"] == base["bonds"]["model"] == "flat_joint"
+    _, p, _, _, _ = _card_setup(MATERIALS / "savonniere_limestone.yaml")
+    assert p.flat_joint == 0 and "model" not in p.overrides()["bonds"]

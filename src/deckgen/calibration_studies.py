@@ -405,7 +405,11 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
                     contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
                     clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
                     clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
-                    **{n: b.get(n, d) for n, d in MicroParams.optional_defaults().items()})
+                    **{n: b.get(n, d) for n, d in MicroParams.optional_defaults().items()},
+                    # the bond law (the base carries it too; without these the study tables said flat_joint 0)
+                    flat_joint=int(b.get("model") == "flat_joint"),
+                    **{n: b[n] for n in ("joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
+                       if n in b})
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 

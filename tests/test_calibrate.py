@@ -674,3 +674,18 @@ def test_study_point_of_a_flat_joint_card_carries_its_bond_law():
     assert p.overrides()["bonds"]["model"] == base["bonds"]["model"] == "flat_joint"
     _, p, _, _, _ = _card_setup(MATERIALS / "savonniere_limestone.yaml")
     assert p.flat_joint == 0 and "model" not in p.overrides()["bonds"]
+
+
+def test_micro_params_from_overrides_inverts_overrides():
+    """A calibrated card's bonds/contact blocks back to the point they came from, the bond law included."""
+    from dataclasses import replace
+
+    fj = MicroParams(youngs_modulus_GPa=14.9, tensile_strength_MPa=6.1, shear_strength_MPa=31.7, gap_tolerance=0.4,
+                     contact_modulus_ratio=4.0, flat_joint=1, joint_friction=1.0, moment_contribution=0.0, face_sectors=3)
+    clumps = replace(fj, flat_joint=0, joint_friction=0.5, moment_contribution=1.0, face_sectors=1, clump_size=8,
+                     clump_strength_factor=50.0, twisting_strength_factor=2.0)
+    for p in (fj, clumps):
+        o = p.overrides()
+        back = MicroParams.from_overrides(o["bonds"], o["contact"])
+        assert back.key() == p.key() and back.contact_modulus_ratio == pytest.approx(p.contact_modulus_ratio)
+        assert (back.flat_joint, back.joint_friction, back.face_sectors) == (p.flat_joint, p.joint_friction, p.face_sectors)

@@ -400,6 +400,23 @@ class MicroParams:
                 del vals["face_gap_tolerance"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
+    @classmethod
+    def from_overrides(cls, bonds: dict[str, Any], contact: dict[str, Any]) -> "MicroParams":
+        """The point whose :meth:`overrides` are these ``bonds`` and ``contact`` blocks (a calibrated card's), the
+        bond law included; fields they do not set keep their defaults."""
+        b, c = bonds, contact
+        return cls(youngs_modulus_GPa=b["youngs_modulus_GPa"], tensile_strength_MPa=b["tensile_strength_MPa"],
+                   shear_strength_MPa=b["shear_strength_MPa"], friction=c.get("friction", 0.5),
+                   rolling_friction=c.get("rolling_friction", 0.1), radius_multiplier=b.get("radius_multiplier", 1.0),
+                   gap_tolerance=b.get("gap_tolerance", 0.05),
+                   contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
+                   clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
+                   clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
+                   **{n: b.get(n, d) for n, d in cls.optional_defaults().items()},
+                   flat_joint=int(b.get("model") == "flat_joint"),
+                   **{n: b[n] for n in ("joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
+                      if n in b})
+
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
         """Case overrides (bonds.*, contact.*); the clump fields only with clumps (clump_size > 1), the
         unbonded fraction and bending/twisting strength factors only when not at their defaults."""

@@ -397,19 +397,7 @@ def _card_setup(card_path: Path) -> tuple[Any, MicroParams, dict[str, Any], dict
     card = load_card(card_path)
     if card.calibrated is None:
         raise CardError(f"{card_path}: calibrated: missing (fix: run python -m deckgen.calibrate on it first)")
-    b, c = card.calibrated.bonds, card.calibrated.contact
-    p = MicroParams(youngs_modulus_GPa=b["youngs_modulus_GPa"], tensile_strength_MPa=b["tensile_strength_MPa"],
-                    shear_strength_MPa=b["shear_strength_MPa"], friction=c.get("friction", 0.5),
-                    rolling_friction=c.get("rolling_friction", 0.1), radius_multiplier=b.get("radius_multiplier", 1.0),
-                    gap_tolerance=b.get("gap_tolerance", 0.05),
-                    contact_modulus_ratio=c.get("youngs_modulus_GPa", b["youngs_modulus_GPa"]) / b["youngs_modulus_GPa"],
-                    clump_size=int(b.get("clump_size", 1)), clump_strength_factor=b.get("clump_strength_factor", 100.0),
-                    clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
-                    **{n: b.get(n, d) for n, d in MicroParams.optional_defaults().items()},
-                    # the bond law (the base carries it too; without these the study tables said flat_joint 0)
-                    flat_joint=int(b.get("model") == "flat_joint"),
-                    **{n: b[n] for n in ("joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
-                       if n in b})
+    p = MicroParams.from_overrides(card.calibrated.bonds, card.calibrated.contact)
     ucs, bts = quasi_static_specimens(card)
     return card, p, card.case_overrides(), ucs, bts
 

@@ -39,5 +39,7 @@ def test_dry_run_plans_the_resolution_study(tmp_path):
                      f"results={tmp_path / 'results'}")
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
-    for rule in ("calibrate 1", "calibrate_fine 1", "calibration_resolution 1"):
+    for rule in ("calibrate 2", "calibration_resolution 1"):  # the card and its fine set-up, then the table
         assert rule in text, (rule, text[-1500:])
+    for setup in ("sandstone.yaml", "fine/sandstone.yaml"):
+        assert f"input: cases/materials/{setup}" in text, (setup, text[-1500:])

@@ -9,15 +9,18 @@ wildcard_constraints:
 
 rule calibrate:
     input:
-        targets="cases/materials/{rock}.yaml",
+        targets="cases/materials/{setup}.yaml",
     output:
-        card=f"{RESULTS}/calibration/{{rock}}/card.yaml",
+        card=f"{RESULTS}/calibration/{{setup}}/card.yaml",
+    wildcard_constraints:
+        # a rock's card, or its set-up at finer grains (cases/materials/fine/<rock>.yaml, issue #3 item 6)
+        setup="(fine/)?[a-z][a-z0-9_]*",
     conda:
         "../envs/deckgen.yaml"
     log:
-        f"{RESULTS}/logs/calibrate/{{rock}}.log",
+        f"{RESULTS}/logs/calibrate/{{setup}}.log",
     benchmark:
-        f"{RESULTS}/benchmarks/calibrate/{{rock}}.tsv"
+        f"{RESULTS}/benchmarks/calibrate/{{setup}}.tsv"
     threads: config.get("ranks", 2)
     priority: 10
     params:
@@ -94,29 +97,9 @@ rule calibration_report:
 
 
 # resolution (issue #3, item 6): a rock's calibration set-up at finer grains, cases/materials/fine/<rock>.yaml,
-# calibrated like the card and tabled beside it (how the micro-parameters move with the grain size):
+# calibrated by the rule above (results/calibration/fine/<rock>/card.yaml) and tabled beside the rock's card (how the
+# micro-parameters move with the grain size):
 #   snakemake --cores 2 results/calibration/resolution_sandstone.md
-rule calibrate_fine:
-    input:
-        targets="cases/materials/fine/{rock}.yaml",
-    output:
-        card=f"{RESULTS}/calibration/fine/{{rock}}/card.yaml",
-    conda:
-        "../envs/deckgen.yaml"
-    log:
-        f"{RESULTS}/logs/calibrate_fine/{{rock}}.log",
-    benchmark:
-        f"{RESULTS}/benchmarks/calibrate_fine/{{rock}}.tsv"
-    threads: config.get("ranks", 2)
-    params:
-        out=lambda w, output: str(Path(output.card).parent),
-        cache=f"{RESULTS}/.cache",
-        engine=calib_engine_args(),
-    shell:
-        "python -m deckgen.calibrate {input.targets} --out {params.out} --cache {params.cache} "
-        "{params.engine} > {log} 2>&1"
-
-
 rule calibration_resolution:
     input:
         coarse=f"{RESULTS}/calibration/{{rock}}/card.yaml",

@@ -620,13 +620,14 @@ def test_resolution_table_orders_by_grain_size_and_gives_ratios_to_the_coarse_ca
     from deckgen.calibrate import write_card
     from deckgen.calibration_studies import resolution_table
 
-    coarse = _card("sandstone")
+    coarse = load_card(ROOT / "docs" / "calibration_runs" / "sandstone_coarse_card.yaml")
     bonds = {**coarse.calibrated.bonds, "youngs_modulus_GPa": coarse.calibrated.bonds["youngs_modulus_GPa"] * 1.1}
     fine = coarse.model_copy(update={
         "calibrated": coarse.calibrated.model_copy(update={"bonds": bonds}),
         "provenance": coarse.provenance.model_copy(update={"radius_min_mm": 0.6, "radius_max_mm": 1.0})})
     write_card(fine, tmp_path / "fine.yaml")
-    text = resolution_table([tmp_path / "fine.yaml", MATERIALS / "sandstone.yaml"])  # fine given first
+    coarse_path = ROOT / "docs" / "calibration_runs" / "sandstone_coarse_card.yaml"
+    text = resolution_table([tmp_path / "fine.yaml", coarse_path])  # fine given first
     rows = [ln for ln in text.splitlines() if ln.startswith("| sandstone")]
     assert len(rows) == 2
     assert rows[0].startswith("| sandstone | 0.8-1.333 | 7.5 | 9.4 |") and "(×1.000)" in rows[0]
@@ -650,20 +651,31 @@ def test_analytic_start_leaves_fixed_fields_at_their_defaults():
     assert 1.0 < p.twisting_strength_factor < 1.01  # free: strictly inside its bounds for least_squares
 
 
-def test_fine_setups_are_the_recorded_resolution_calibrations():
-    """cases/materials/fine/<rock>.yaml is what docs/calibration_runs/<rock>_fine_card.yaml was calibrated from, and
-    differs from the rock's card only in the grain size (and the start and budget)."""
-    for path in sorted((MATERIALS / "fine").glob("*.yaml")):
+def test_resolution_setups_are_the_recorded_calibrations():
+    """cases/materials/{coarse,fine}/<rock>.yaml is what docs/calibration_runs/<rock>_{coarse,fine}_card.yaml was
+    calibrated from, and differs from the rock's card only in the grain size (and the start and budget)."""
+    setups = sorted((MATERIALS / "fine").glob("*.yaml")) + sorted((MATERIALS / "coarse").glob("*.yaml"))
+    assert {(p.parent.name, p.stem) for p in setups} >= {("coarse", "sandstone"), ("fine", "colorado_red_granite")}
+    for path in setups:
         setup = load_card(path)
-        recorded = load_card(ROOT / "docs" / "calibration_runs" / f"{setup.rock}_fine_card.yaml")
+        recorded = load_card(ROOT / "docs" / "calibration_runs" / f"{setup.rock}_{path.parent.name}_card.yaml")
         assert setup.calibrated is None and setup.calibration == recorded.calibration
-        coarse = _card(setup.rock)
-        assert setup.targets == coarse.targets
+        card = _card(setup.rock)
+        assert setup.targets == card.targets
         same = {"start", "max_evals", "base"}
-        assert setup.calibration.model_dump(exclude=same) == coarse.calibration.model_dump(exclude=same)
-        fine_r, coarse_r = setup.calibration.base["packing"], coarse.calibration.base["packing"]
-        assert fine_r["radius_max_mm"] < coarse_r["radius_max_mm"]
-        assert recorded.provenance.radius_max_mm == fine_r["radius_max_mm"] and recorded.provenance.converged
+        assert setup.calibration.model_dump(exclude=same) == card.calibration.model_dump(exclude=same)
+        r, card_r = setup.calibration.base["packing"], card.calibration.base["packing"]
+        finer = path.parent.name == "fine"
+        assert (r["radius_max_mm"] < card_r["radius_max_mm"]) == finer and r["radius_max_mm"] != card_r["radius_max_mm"]
+        assert recorded.provenance.radius_max_mm == r["radius_max_mm"] and recorded.provenance.converged
+
+
+def test_sandstone_card_is_its_fine_resolution_calibration():
+    """Since session 17 the sandstone card is the one calibrated at r 0.6-1.0 mm (quasi-static to 3 %; the coarse one
+    was not): the same card as the resolution record."""
+    card = _card("sandstone")
+    assert card == load_card(ROOT / "docs" / "calibration_runs" / "sandstone_fine_card.yaml")
+    assert card.provenance.converged and card.provenance.radius_max_mm == 1.0
 
 
 def test_study_point_of_a_flat_joint_card_carries_its_bond_law():

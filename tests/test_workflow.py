@@ -35,11 +35,13 @@ def test_lint_is_clean():
 
 
 def test_dry_run_plans_the_resolution_study(tmp_path):
-    res = _snakemake("-n", f"{tmp_path}/results/calibration/resolution_sandstone.md", "--config",
-                     f"results={tmp_path / 'results'}")
-    assert res.returncode == 0, res.stderr[-2000:]
-    text = " ".join((res.stdout + res.stderr).split())
-    for rule in ("calibrate 2", "calibration_resolution 1"):  # the card and its fine set-up, then the table
-        assert rule in text, (rule, text[-1500:])
-    for setup in ("sandstone.yaml", "fine/sandstone.yaml"):
-        assert f"input: cases/materials/{setup}" in text, (setup, text[-1500:])
+    """A rock's card and its set-up at the other grain size (sandstone: coarse/, granite: fine/), then the table."""
+    for rock, other in (("sandstone", "coarse"), ("colorado_red_granite", "fine")):
+        res = _snakemake("-n", f"{tmp_path}/results/calibration/resolution_{rock}.md", "--config",
+                         f"results={tmp_path / 'results'}")
+        assert res.returncode == 0, res.stderr[-2000:]
+        text = " ".join((res.stdout + res.stderr).split())
+        for rule in ("calibrate 2", "calibration_resolution 1"):
+            assert rule in text, (rule, text[-1500:])
+        for setup in (f"{rock}.yaml", f"{other}/{rock}.yaml"):
+            assert f"input: cases/materials/{setup}" in text, (setup, text[-1500:])

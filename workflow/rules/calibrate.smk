@@ -13,8 +13,8 @@ rule calibrate:
     output:
         card=f"{RESULTS}/calibration/{{setup}}/card.yaml",
     wildcard_constraints:
-        # a rock's card, or its set-up at finer grains (cases/materials/fine/<rock>.yaml, issue #3 item 6)
-        setup="(fine/)?[a-z][a-z0-9_]*",
+        # a rock's card, or its set-up at other grains (cases/materials/{coarse,fine}/<rock>.yaml, issue #3 item 6)
+        setup="((coarse|fine)/)?[a-z][a-z0-9_]*",
     conda:
         "../envs/deckgen.yaml"
     log:
@@ -96,14 +96,14 @@ rule calibration_report:
         f"{RESULTS}/calibration/table.md",
 
 
-# resolution (issue #3, item 6): a rock's calibration set-up at finer grains, cases/materials/fine/<rock>.yaml,
-# calibrated by the rule above (results/calibration/fine/<rock>/card.yaml) and tabled beside the rock's card (how the
-# micro-parameters move with the grain size):
+# resolution (issue #3, item 6): a rock's calibration set-ups at other grain sizes, cases/materials/coarse/<rock>.yaml
+# and/or cases/materials/fine/<rock>.yaml, calibrated by the rule above (results/calibration/{coarse,fine}/<rock>/card.yaml)
+# and tabled beside the rock's card, coarsest first (how the micro-parameters move with the grain size):
 #   snakemake --cores 2 results/calibration/resolution_sandstone.md
+# (inputs: resolution_cards in common.smk)
 rule calibration_resolution:
     input:
-        coarse=f"{RESULTS}/calibration/{{rock}}/card.yaml",
-        fine=f"{RESULTS}/calibration/fine/{{rock}}/card.yaml",
+        resolution_cards,
     output:
         f"{RESULTS}/calibration/resolution_{{rock}}.md",
     log:
@@ -111,4 +111,4 @@ rule calibration_resolution:
     conda:
         "../envs/deckgen.yaml"
     shell:
-        "python -m deckgen.calibration_studies resolution {input.coarse} {input.fine} --write {output} > {log} 2>&1"
+        "python -m deckgen.calibration_studies resolution {input} --write {output} > {log} 2>&1"

@@ -88,3 +88,17 @@ def calib_engine_args():
 def family_case_names(wildcards):
     """Case names of one family and scale (rules/families.smk)."""
     return list(FAMILY_CASES[(wildcards.family, wildcards.scale)])
+
+
+# issue #3 item 6: a rock's card and its calibration set-ups at other grain sizes (rule calibration_resolution)
+RESOLUTION_SIZES = ("coarse", "fine")
+
+
+def resolution_cards(wildcards):
+    cards = [f"{RESULTS}/calibration/{wildcards.rock}/card.yaml"]
+    cards += [f"{RESULTS}/calibration/{size}/{wildcards.rock}/card.yaml" for size in RESOLUTION_SIZES
+              if Path(f"cases/materials/{size}/{wildcards.rock}.yaml").is_file()]
+    if len(cards) == 1:
+        raise ValueError(f"resolution_{wildcards.rock}: no cases/materials/coarse/{wildcards.rock}.yaml or "
+                         f"cases/materials/fine/{wildcards.rock}.yaml (fix: add a set-up at another grain size)")
+    return cards

@@ -518,12 +518,13 @@ def test_results_table_names_the_bond_law_and_the_seed_scatter(tmp_path):
     studies = tmp_path  # the session-13 concrete card (crushed discs) with its own seed and speed studies
     for kind in ("seeds", "quasistatic"):
         shutil.copy(runs / f"{kind}_concrete_crushed.csv", studies / f"{kind}_concrete.csv")
-    shutil.copy(runs / "seeds_savonniere_limestone.csv", studies)
-    text = results_table([runs / "concrete_flat_joint_crushed_card.yaml", MATERIALS / "savonniere_limestone.yaml"],
+    shutil.copy(runs / "seeds_savonniere_limestone_bpm.csv", studies / "seeds_savonniere_limestone.csv")
+    text = results_table([runs / "concrete_flat_joint_crushed_card.yaml", runs / "savonniere_limestone_bpm_card.yaml"],
                          studies)
     concrete = next(ln for ln in text.splitlines() if ln.startswith("| concrete |"))
     limestone = next(ln for ln in text.splitlines() if ln.startswith("| savonniere_limestone |"))
     assert "| flat joint, β 0 |" in concrete and "| bpm/rotational |" in limestone
+    assert concrete.startswith("| concrete | 0.8-1.333 | ") and limestone.startswith("| savonniere_limestone | 0.8-1.333 | ")
     s = scatter(pd.read_csv(studies / "seeds_concrete.csv"))
     card = load_card(runs / "concrete_flat_joint_crushed_card.yaml")
     assert f"{s['bts_Pa_mean'] / (card.targets.bts_MPa * 1e6) - 1:+.1%}" in concrete
@@ -684,7 +685,7 @@ def test_study_point_of_a_flat_joint_card_carries_its_bond_law():
     _, p, base, _, _ = _card_setup(MATERIALS / "sandstone.yaml")
     assert (p.flat_joint, p.joint_friction, p.moment_contribution) == (1, 1.0, 0.0)
     assert p.overrides()["bonds"]["model"] == base["bonds"]["model"] == "flat_joint"
-    _, p, _, _, _ = _card_setup(MATERIALS / "savonniere_limestone.yaml")
+    _, p, _, _, _ = _card_setup(ROOT / "docs" / "calibration_runs" / "savonniere_limestone_bpm_card.yaml")
     assert p.flat_joint == 0 and "model" not in p.overrides()["bonds"]
 
 

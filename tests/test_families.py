@@ -172,7 +172,7 @@ def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     assert bg["tensile_strength_MPa"] / 10 == pytest.approx(g["tensile_strength_MPa"] / g["youngs_modulus_GPa"], rel=1e-3)
     assert bg["shear_strength_MPa"] / bg["tensile_strength_MPa"] == pytest.approx(g["shear_strength_MPa"] / g["tensile_strength_MPa"], rel=1e-3)
     assert "calibrated card" in " ".join(lg)
-    # a converged card is used as calibrated (limestone: E_b 58.2 GPa, sigma = tau 42.7 MPa, g ~ 0)
+    # a converged card is used as calibrated (limestone: flat joint since session 17, E_b 28.0 GPa, sigma_c 2.18 MPa)
     card = yaml.safe_load((ROOT / "cases/materials/savonniere_limestone.yaml").read_text())["calibrated"]
     bl, cl, ll = fam.rock_micro("savonniere_limestone", soften_to_GPa=10)
     F = card["bonds"]["youngs_modulus_GPa"] / 10
@@ -181,7 +181,7 @@ def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     assert "calibrated card" in " ".join(ll)
     # a flat-joint card keeps its bond law (sandstone, concrete and granite, converged with the Brazilian strength read
     # at the split, session 15); a card without a converged calibration is not used
-    for rock in ("sandstone", "concrete", "colorado_red_granite"):
+    for rock in ("sandstone", "concrete", "colorado_red_granite", "savonniere_limestone"):
         assert fam.calibrated_card(rock)["bonds"]["model"] == "flat_joint", rock
     assert fam.calibrated_card("no_such_rock") is None
 

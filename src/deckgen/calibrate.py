@@ -552,7 +552,7 @@ TAU_RATIO_START = 1.0
 
 
 #: Measured at high bond failure strain (``python -m deckgen.calibration_studies ratio --set high-strain --card
-#: cases/materials/sandstone.yaml --bts-packings 3 --bts-stop 0.2``; docs/calibration_runs/ratio_high_strain.csv):
+#: cases/materials/coarse/sandstone.yaml --bts-packings 3 --bts-stop 0.2``; docs/calibration_runs/ratio_high_strain.csv):
 #: E_b 20 GPa, interaction range g 0.4, contact modulus 4 E_b, sandstone density and quasi-static platen speeds,
 #: coarse grains, BTS the mean of three discs run until the load fell to 20 % of its peak. Rows:
 #: (sigma_c/E_b, tau_c/sigma_c, E/E_b, UCS/sigma_c, BTS/sigma_c). UCS/BTS: 5.9 at tau/sigma 1, 8.2 at 0.5,
@@ -571,7 +571,7 @@ HIGH_STRAIN_GAP, HIGH_STRAIN_CONTACT_RATIO = 0.4, 4.0
 
 
 #: Measured with the flat joint (``bonds.model: flat_joint``, moment contribution beta 0, joint friction 0.5; ``python
-#: -m deckgen.calibration_studies ratio --set flat-joint --card cases/materials/sandstone.yaml --bts-packings 3
+#: -m deckgen.calibration_studies ratio --set flat-joint --card cases/materials/coarse/sandstone.yaml --bts-packings 3
 #: --bts-stop 0.2``; docs/calibration_runs/ratio_flat_joint.csv): E_b 20 GPa, g 0.4, contact modulus 4 E_b,
 #: sandstone density and platen speeds, coarse grains, BTS the mean of three discs. Rows: (sigma_c MPa, c MPa,
 #: E GPa, UCS MPa, BTS MPa at the peak, BTS MPa at the split). UCS/BTS rises with c/sigma_c: 5.8, 8.3, 8.3, 11.9,

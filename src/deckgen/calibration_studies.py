@@ -497,10 +497,11 @@ def _split_cell(broken: float | None, limit: float | None, reading: str = "peak"
 
 def results_table(cards: list[Path], studies: Path) -> str:
     """Markdown table: per rock the achieved values, errors, evaluations, wall time and seed scatter."""
-    head = ("| rock | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations | wall min (2 cores) "
-            "| bond law | E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b | new seeds: UCS, BTS, E mean ± sd (CV) "
-            "| new-seed mean vs target | half speed: ΔUCS, ΔBTS | BTS read at: bonds broken there |\n"
-            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
+    head = ("| rock | grain radii mm | UCS MPa (err) | BTS MPa (err) | E GPa (err) | ν | UCS/BTS | evaluations "
+            "| wall min (2 cores) | bond law | E_b GPa | σ_c MPa | τ_c/σ_c | g | E_c/E_b "
+            "| new seeds: UCS, BTS, E mean ± sd (CV) | new-seed mean vs target | half speed: ΔUCS, ΔBTS "
+            "| BTS read at: bonds broken there |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for path in cards:
         try:
@@ -510,7 +511,7 @@ def results_table(cards: list[Path], studies: Path) -> str:
             continue
         p = card.provenance
         if p is None or card.calibrated is None:
-            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | | | |")
+            lines.append(f"| {card.rock} | not calibrated | | | | | | | | | | | | | | | | | |")
             continue
         a, b = p.achieved, card.calibrated.bonds
         nu = "–"
@@ -533,8 +534,10 @@ def results_table(cards: list[Path], studies: Path) -> str:
             q = pd.read_csv(qfile)
             if len(q) == 2:
                 qs = f"{q['ucs_change_at_half_speed_1'].iloc[1]:+.1%}, {q['bts_change_at_half_speed_1'].iloc[1]:+.1%}"
+        radii = (f"{p.radius_min_mm:g}-{p.radius_max_mm:g}" if p.radius_min_mm is not None and p.radius_max_mm is not None
+                 else "–")
         lines.append(
-            f"| {card.rock} | {a.ucs_MPa:.4g} ({a.ucs_error:+.1%}) | {a.bts_MPa:.4g} ({a.bts_error:+.1%}) | "
+            f"| {card.rock} | {radii} | {a.ucs_MPa:.4g} ({a.ucs_error:+.1%}) | {a.bts_MPa:.4g} ({a.bts_error:+.1%}) | "
             f"{a.youngs_modulus_GPa:.4g} ({a.youngs_modulus_error:+.1%}) | {nu} | {a.ucs_MPa / a.bts_MPa:.3g} | "
             f"{p.evaluations}{'' if p.converged else ' (not converged)'} | {p.wall_s / 60:.1f} | "
             f"{_bond_law(b)} | {b['youngs_modulus_GPa']:.4g} | {b['tensile_strength_MPa']:.4g} | "

@@ -519,7 +519,7 @@ def test_results_table_names_the_bond_law_and_the_seed_scatter(tmp_path):
     for kind in ("seeds", "quasistatic"):
         shutil.copy(runs / f"{kind}_concrete_crushed.csv", studies / f"{kind}_concrete.csv")
     shutil.copy(runs / "seeds_savonniere_limestone_bpm.csv", studies / "seeds_savonniere_limestone.csv")
-    text = results_table([runs / "concrete_flat_joint_crushed_card.yaml", runs / "savonniere_limestone_bpm_card.yaml"],
+    text = results_table([runs / "concrete_flat_joint_crushed_card.yaml", MATERIALS / "cutting" / "savonniere_limestone.yaml"],
                          studies)
     concrete = next(ln for ln in text.splitlines() if ln.startswith("| concrete |"))
     limestone = next(ln for ln in text.splitlines() if ln.startswith("| savonniere_limestone |"))
@@ -685,7 +685,7 @@ def test_study_point_of_a_flat_joint_card_carries_its_bond_law():
     _, p, base, _, _ = _card_setup(MATERIALS / "sandstone.yaml")
     assert (p.flat_joint, p.joint_friction, p.moment_contribution) == (1, 1.0, 0.0)
     assert p.overrides()["bonds"]["model"] == base["bonds"]["model"] == "flat_joint"
-    _, p, _, _, _ = _card_setup(ROOT / "docs" / "calibration_runs" / "savonniere_limestone_bpm_card.yaml")
+    _, p, _, _, _ = _card_setup(MATERIALS / "cutting" / "savonniere_limestone.yaml")
     assert p.flat_joint == 0 and "model" not in p.overrides()["bonds"]
 
 

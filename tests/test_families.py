@@ -154,7 +154,7 @@ def test_reduced_scale_headers_state_the_scaling():
 def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     """Softening divides moduli and strengths alike: sigma_c/E_b (the bond failure strain) is the unsoftened one."""
     with monkeypatch.context() as m:  # a rock without a converged card (all four have one since session 15)
-        m.setattr(fam, "calibrated_card", lambda rock: None)
+        m.setattr(fam, "calibrated_card", lambda rock, path=None: None)
         b, c, lines = fam.rock_micro("colorado_red_granite")
         # placeholder: smoke rock (E_b 40 GPa, sigma 30 MPa -> UCS 19.7 MPa, E 12 GPa) scaled to E 41 GPa, UCS 158 MPa
         assert b["youngs_modulus_GPa"] == pytest.approx(40 * 41 / 12, rel=1e-3)
@@ -172,15 +172,19 @@ def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     assert bg["tensile_strength_MPa"] / 10 == pytest.approx(g["tensile_strength_MPa"] / g["youngs_modulus_GPa"], rel=1e-3)
     assert bg["shear_strength_MPa"] / bg["tensile_strength_MPa"] == pytest.approx(g["shear_strength_MPa"] / g["tensile_strength_MPa"], rel=1e-3)
     assert "calibrated card" in " ".join(lg)
-    # a converged card is used as calibrated (limestone: flat joint since session 17, E_b 28.0 GPa, sigma_c 2.18 MPa)
-    card = yaml.safe_load((ROOT / "cases/materials/savonniere_limestone.yaml").read_text())["calibrated"]
+    # the cutting families take cases/materials/cutting/<rock>.yaml where there is one: limestone's bpm card (E_b 58.2
+    # GPa, sigma = tau 42.7 MPa, g ~ 0), since its flat-joint card shatters the reduced ODC block (session 17)
+    assert fam.cutting_card_path("savonniere_limestone") == ROOT / "cases/materials/cutting/savonniere_limestone.yaml"
+    assert fam.cutting_card_path("colorado_red_granite") == ROOT / "cases/materials/colorado_red_granite.yaml"
+    card = yaml.safe_load((ROOT / "cases/materials/cutting/savonniere_limestone.yaml").read_text())["calibrated"]
     bl, cl, ll = fam.rock_micro("savonniere_limestone", soften_to_GPa=10)
     F = card["bonds"]["youngs_modulus_GPa"] / 10
+    assert F == pytest.approx(5.822, rel=1e-3) and "model" not in bl
     assert bl["tensile_strength_MPa"] == pytest.approx(card["bonds"]["tensile_strength_MPa"] / F, rel=1e-3)
     assert bl["gap_tolerance"] == card["bonds"]["gap_tolerance"] and cl["friction"] == card["contact"]["friction"]
-    assert "calibrated card" in " ".join(ll)
-    # a flat-joint card keeps its bond law (sandstone, concrete and granite, converged with the Brazilian strength read
-    # at the split, session 15); a card without a converged calibration is not used
+    assert "calibrated card cases/materials/cutting/savonniere_limestone.yaml" in " ".join(ll)
+    # a flat-joint card keeps its bond law (all four rocks' cards since session 17, converged with the Brazilian
+    # strength read at the split); a card without a converged calibration is not used
     for rock in ("sandstone", "concrete", "colorado_red_granite", "savonniere_limestone"):
         assert fam.calibrated_card(rock)["bonds"]["model"] == "flat_joint", rock
     assert fam.calibrated_card("no_such_rock") is None

@@ -86,8 +86,9 @@ def _tag(x: float) -> str:
     return str(v).replace(".", "p").replace("-", "m")
 
 
-def calibrated_card(rock: str) -> dict[str, Any] | None:
-    """The micro-parameters of cases/materials/<rock>.yaml when its calibration converged, else None.
+def calibrated_card(rock: str, path: Path | None = None) -> dict[str, Any] | None:
+    """The micro-parameters of a rock's card (default cases/materials/<rock>.yaml) when its calibration converged,
+    else None.
 
     ``{"bonds": ..., "contact": ...}``: the card's ``calibration.base`` blocks with the ``calibrated``
     values over them; without a calibrated contact modulus, E_c = E_b when the calibration tied them,
@@ -96,7 +97,7 @@ def calibrated_card(rock: str) -> dict[str, Any] | None:
     from deckgen.render import repo_root
     from deckgen.spec import Contact
 
-    path = repo_root() / "cases" / "materials" / f"{rock}.yaml"
+    path = path if path is not None else repo_root() / "cases" / "materials" / f"{rock}.yaml"
     if not path.is_file():
         return None
     card = load_card(path)  # the validated card, as the calibration reads it
@@ -111,20 +112,34 @@ def calibrated_card(rock: str) -> dict[str, Any] | None:
     return {"bonds": bonds, "contact": contact}
 
 
+def cutting_card_path(rock: str) -> Path:
+    """The card the cutting families take for ``rock``: cases/materials/cutting/<rock>.yaml where the rock's card
+    does not cut (limestone since session 17: the flat-joint card shatters the reduced ODC block, docs/families.md),
+    else the rock's card cases/materials/<rock>.yaml."""
+    from deckgen.render import repo_root
+
+    materials = repo_root() / "cases" / "materials"
+    cutting = materials / "cutting" / f"{rock}.yaml"
+    return cutting if cutting.is_file() else materials / f"{rock}.yaml"
+
+
 def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str, Any], dict[str, Any], list[str]]:
     """Bond and contact blocks of a family case for ``rock``, and the header lines that say where they come from.
 
-    A converged card (cases/materials/<rock>.yaml, issue #3) gives the micro-parameters. Otherwise a
+    A converged card (cases/materials/cutting/<rock>.yaml if there is one, else cases/materials/<rock>.yaml; issue #3)
+    gives the micro-parameters. Otherwise a
     placeholder scales the smoke UCS rock (E_b = E_c 40 GPa, sigma_c 30, tau_c 60 MPa -> UCS 19.7 MPa,
     E 12.0 GPa) to the rock: moduli x E/12 GPa, strengths x UCS/19.7 MPa, so the bond failure strain
     sigma_c/E_b follows the rock's UCS/E. With ``soften_to_GPa`` moduli AND strengths are divided by
     F = E_b/soften (when F > 1): the time step grows by sqrt(F), failure strains (brittleness) and all
     force ratios stay, forces are 1/F of the rock's.
     """
-    card = calibrated_card(rock)
+    path = cutting_card_path(rock)
+    card = calibrated_card(rock, path)
     if card:
         b, c = dict(card["bonds"]), dict(card["contact"])
-        source = f"calibrated card cases/materials/{rock}.yaml (issue #3; calibrated at its own grain size)"
+        rel = f"cases/materials/{path.parent.name}/{path.name}" if path.parent.name == "cutting" else f"cases/materials/{path.name}"
+        source = f"calibrated card {rel} (issue #3; calibrated at its own grain size)"
     else:
         k_e = ROCKS[rock]["youngs_modulus_GPa"] / SMOKE_E_GPA
         k_s = ROCKS[rock]["ucs_MPa"] / SMOKE_UCS_MPA

@@ -52,7 +52,8 @@ rule calibration_seeds:
         "{params.engine} > {log} 2>&1"
 
 
-# quasi-static check: the calibrated point again at half the platen speeds
+# quasi-static check: the calibrated point again at half the platen speeds, on 3 cylinders and 8 discs per speed
+# (single specimens scatter by 4-15 %, more than the 3 % the check asks for)
 rule calibration_quasistatic:
     input:
         card=f"{RESULTS}/calibration/{{rock}}/card.yaml",
@@ -70,7 +71,7 @@ rule calibration_quasistatic:
         engine=calib_engine_args(),
     shell:
         "python -m deckgen.calibration_studies quasistatic {input.card} --out {params.out} "
-        "--cache {params.cache} {params.engine} > {log} 2>&1"
+        "--ucs-packings 3 --bts-packings 8 --cache {params.cache} {params.engine} > {log} 2>&1"
 
 
 # the per-rock results table of issue #3:  snakemake --cores 2 calibration_report

@@ -621,13 +621,13 @@ def test_resolution_table_orders_by_grain_size_and_gives_ratios_to_the_coarse_ca
     from deckgen.calibrate import write_card
     from deckgen.calibration_studies import resolution_table
 
-    coarse = load_card(ROOT / "docs" / "calibration_runs" / "sandstone_coarse_card.yaml")
+    coarse_path = ROOT / "docs" / "calibration_runs" / "sandstone_coarse_card.yaml"
+    coarse = load_card(coarse_path)
     bonds = {**coarse.calibrated.bonds, "youngs_modulus_GPa": coarse.calibrated.bonds["youngs_modulus_GPa"] * 1.1}
     fine = coarse.model_copy(update={
         "calibrated": coarse.calibrated.model_copy(update={"bonds": bonds}),
         "provenance": coarse.provenance.model_copy(update={"radius_min_mm": 0.6, "radius_max_mm": 1.0})})
     write_card(fine, tmp_path / "fine.yaml")
-    coarse_path = ROOT / "docs" / "calibration_runs" / "sandstone_coarse_card.yaml"
     text = resolution_table([tmp_path / "fine.yaml", coarse_path])  # fine given first
     rows = [ln for ln in text.splitlines() if ln.startswith("| sandstone")]
     assert len(rows) == 2

@@ -134,12 +134,13 @@ def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str,
     F = E_b/soften (when F > 1): the time step grows by sqrt(F), failure strains (brittleness) and all
     force ratios stay, forces are 1/F of the rock's.
     """
+    from deckgen.render import repo_root
+
     path = cutting_card_path(rock)
     card = calibrated_card(rock, path)
     if card:
         b, c = dict(card["bonds"]), dict(card["contact"])
-        rel = f"cases/materials/{path.parent.name}/{path.name}" if path.parent.name == "cutting" else f"cases/materials/{path.name}"
-        source = f"calibrated card {rel} (issue #3; calibrated at its own grain size)"
+        source = f"calibrated card {path.relative_to(repo_root()).as_posix()} (issue #3; calibrated at its own grain size)"
     else:
         k_e = ROCKS[rock]["youngs_modulus_GPa"] / SMOKE_E_GPA
         k_s = ROCKS[rock]["ucs_MPa"] / SMOKE_UCS_MPA

@@ -66,11 +66,15 @@ timestep {DT:.10g}
 
 
 def _two_grains(tmp: Path, moves: list[tuple[float, float, int]], beta: float = 1.0,
-                spin_period_s: float = 0.0, sectors: int = 1, gap: float = 0.0, slit: int = 0) -> np.ndarray:
+                spin_period_s: float = 0.0, sectors: int = 1, gap: float = 0.0, slit: int = 0,
+                mu_b: float | None = None) -> np.ndarray:
     """Grain 1 held, grain 2 moved by ``(vx, vy, steps)`` legs (or, with ``spin_period_s``, turned about its own
     centre and the z axis for ``steps``); ``sectors`` > 1: a face of that many elements in one ring; ``gap``: grain
-    2 starts that far from touching; ``slit``: the bond's slit code; returns rows step, fx2, fy2 every step."""
-    elements = f" {slit} {sectors} 1" if sectors > 1 else (f" {slit}" if slit else "")
+    2 starts that far from touching; ``slit``: the bond's slit code; ``mu_b``: the intact bond's own friction (the
+    13th coefficient); returns rows step, fx2, fy2 every step."""
+    elements = f" {slit} {sectors} 1" if sectors > 1 or mu_b is not None else (f" {slit}" if slit else "")
+    if mu_b is not None:
+        elements += f" {mu_b:.10g}"
     lib = plugins.install(tmp, "flatjoint")
     if spin_period_s:
         legs = "\n".join(f"fix m g2 move rotate {2 * R:.10g} 0 0 0 0 1 {spin_period_s:.10g}\nrun {n}\nunfix m"
@@ -112,21 +116,27 @@ def test_tension_breaks_at_sigma_c_and_the_broken_face_carries_compression_only(
 
 
 @needs_engine
-@pytest.mark.parametrize("squeeze_um", [0.0, 1.0])
-def test_shear_strength_is_cohesion_plus_friction_times_compression(tmp_path, squeeze_um):
+@pytest.mark.parametrize("squeeze_um,mu_b", [(0.0, None), (1.0, None), (1.0, 0.0), (1.0, 1.5)])
+def test_shear_strength_is_cohesion_plus_friction_times_compression(tmp_path, squeeze_um, mu_b):
     v = STEP / DT
     n_sq = int(round(squeeze_um * 1e-6 / STEP))
-    f = _two_grains(tmp_path, ([(-v, 0.0, n_sq)] if n_sq else []) + [(0.0, v, 16000)])
+    f = _two_grains(tmp_path, ([(-v, 0.0, n_sq)] if n_sq else []) + [(0.0, v, 16000)], mu_b=mu_b)
     (brk,) = _breaks(tmp_path)
     assert brk[3] == "2"  # shear
     k = int(brk[0]) - 1  # the last step before the break
-    fx, fy = f[k - 1, 1], f[k - 1, 2]
-    sigma_n = max(fx, 0.0) / AREA  # compression pushes grain 2 to +x
-    assert sigma_n * AREA == pytest.approx(K_N * squeeze_um * 1e-6, rel=2e-2, abs=1e-3)
-    expected = (COH + MU * sigma_n) * AREA  # 6.28 N alone, 7.07 N with 0.5 MPa of compression
-    assert -fy == pytest.approx(expected, rel=5e-3)
+    step, fx, fy = f[k - 1, 0], f[k - 1, 1], f[k - 1, 2]
+    # the bond's frame: grain 2 has slid (step - n_sq) * STEP along y at x = 2R - squeeze, so the normal is turned by
+    # theta (7 mrad at 14 um of slip); resolving in it keeps the normal and shear forces apart
+    theta = math.atan2((step - n_sq) * STEP, 2 * R - squeeze_um * 1e-6)
+    f_normal = fx * math.cos(theta) + fy * math.sin(theta)  # compression pushes grain 2 away from grain 1
+    f_shear = -fx * math.sin(theta) + fy * math.cos(theta)
+    sigma_n = max(f_normal, 0.0) / AREA
+    assert sigma_n * AREA == pytest.approx(K_N * squeeze_um * 1e-6, rel=6e-2, abs=1e-3)
+    # 6.28 N alone, 7.07 N with 0.5 MPa of compression; the intact bond's own friction mu_b replaces mu here
+    expected = (COH + (MU if mu_b is None else mu_b) * sigma_n) * AREA
+    assert -f_shear == pytest.approx(expected, rel=5e-3)
     tail = f[k + 10:]
-    if squeeze_um:  # after breaking, the closed face slides at mu times its normal force
+    if squeeze_um:  # after breaking, the closed face slides at mu (the broken face's, whatever mu_b) times its normal force
         assert np.allclose(np.abs(tail[:, 2]), MU * tail[:, 1], rtol=0.05)
     else:  # nothing presses the broken face: no shear either
         assert np.all(np.abs(tail[:, 2]) < 1e-9)
@@ -225,6 +235,10 @@ def test_flat_joint_validation_names_field_and_fix():
     with pytest.raises(SpecError, match="face_gap_tolerance: 0.03 is not above gap_tolerance 0.05"):
         load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "gap_tolerance": 0.05,
                                                                 "face_gap_tolerance": 0.03}})
+    with pytest.raises(SpecError, match="bond_friction: used only by model: flat_joint"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"bond_friction": 0.1}})
+    with pytest.raises(SpecError, match="bond_friction"):
+        load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "bond_friction": -0.1}})
     with pytest.raises(SpecError, match="face_sectors: used only by model: flat_joint"):
         load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"face_sectors": 4}})
     with pytest.raises(SpecError, match="face_sectors: 2 halves"):
@@ -249,6 +263,13 @@ def test_micro_params_keep_their_keys_and_map_the_flat_joint():
     e = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0, flat_joint=1,
                     face_sectors=4)
     assert e.key() != q.key() and e.overrides()["bonds"]["face_sectors"] == 4
+    m = MicroParams(youngs_modulus_GPa=20.0, tensile_strength_MPa=60.0, shear_strength_MPa=60.0, flat_joint=1,
+                    bond_friction=0.0)
+    assert "bond_friction" not in q.overrides()["bonds"] and m.overrides()["bonds"]["bond_friction"] == 0.0
+    assert m.key() != q.key() and MicroParams.from_overrides(**m.overrides()) == m
+    from deckgen.calibration_studies import _bond_law
+
+    assert _bond_law(m.overrides()["bonds"]) == "flat joint, intact μ 0" and _bond_law(q.overrides()["bonds"]) == "flat joint"
 
 
 def test_flat_joint_start_table_returns_a_measured_point_for_its_own_macro_values():
@@ -295,6 +316,12 @@ def test_deck_loads_the_plugin_from_the_run_folder_with_si_coefficients(tmp_path
         [b.youngs_modulus_GPa * 1e9, b.stiffness_ratio, b.radius_multiplier, b.tensile_strength_MPa * 1e6,
          b.shear_strength_MPa * 1e6, 0.7, b.damping_ratio, 1.0])
     assert "bpm/rotational" not in deck and "broken.dump.gz" not in deck
+    # bonds.bond_friction: the intact bond's own friction, the plugin's 13th argument after slit 0, 1 sector, 1 ring
+    case = load_case(CASES / "tiny_ucs.yaml", overrides={"bonds": {"model": "flat_joint", "joint_friction": 0.7,
+                                                                   "bond_friction": 0.1}})
+    render_case(case, tmp_path / "mu_b", progress=False)
+    line = next(ln for ln in (tmp_path / "mu_b" / "in.deck").read_text().splitlines() if ln.startswith("bond_coeff"))
+    assert [float(v) for v in line.split()[7:]] == pytest.approx([0.7, b.damping_ratio, 1.0, 0.0, 1.0, 1.0, 0.1])
 
 
 def test_broken_joints_file_is_read_with_modes_and_fails_with_file_and_line(tmp_path):

@@ -364,6 +364,7 @@ class MicroParams:
     moment_contribution: float = 1.0  # bonds.moment_contribution (flat joint only)
     face_sectors: int = 1  # bonds.face_sectors (flat joint only; 1 = the one-element face)
     face_gap_tolerance: float = 0.0  # bonds.face_gap_tolerance (flat joint only; 0 = no gapped faces)
+    bond_friction: float = -1.0  # bonds.bond_friction (flat joint only; -1 = unset: the intact bond takes joint_friction)
     stiffness_ratio: float = 2.5  # bonds.stiffness_ratio k_n/k_s (the Bonds default)
 
     @classmethod
@@ -390,7 +391,7 @@ class MicroParams:
                 del vals[name]
         if vals["flat_joint"] == 0:  # bpm_rotational points keep the keys they had before the flat joint
             del vals["flat_joint"], vals["joint_friction"], vals["moment_contribution"], vals["face_sectors"]
-            del vals["face_gap_tolerance"]
+            del vals["face_gap_tolerance"], vals["bond_friction"]
         else:
             if vals["moment_contribution"] == 1.0:  # flat-joint points recorded before beta existed
                 del vals["moment_contribution"]
@@ -398,6 +399,8 @@ class MicroParams:
                 del vals["face_sectors"]
             if vals["face_gap_tolerance"] == 0.0:  # ... and before gapped faces
                 del vals["face_gap_tolerance"]
+            if vals["bond_friction"] == -1.0:  # ... and before the intact bond had its own friction
+                del vals["bond_friction"]
         return hashlib.sha1(json.dumps(vals, sort_keys=True).encode()).hexdigest()[:16]
 
     @classmethod
@@ -414,7 +417,8 @@ class MicroParams:
                    clump_stiffness_factor=b.get("clump_stiffness_factor", 1.0),
                    **{n: b.get(n, d) for n, d in cls.optional_defaults().items()},
                    flat_joint=int(b.get("model") == "flat_joint"),
-                   **{n: b[n] for n in ("joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance")
+                   **{n: b[n] for n in ("joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
+                                        "bond_friction")
                       if n in b})
 
     def overrides(self, tie_contact_modulus: bool = True) -> dict[str, Any]:
@@ -437,6 +441,8 @@ class MicroParams:
                 bonds["face_sectors"] = int(self.face_sectors)
             if self.face_gap_tolerance != 0.0:
                 bonds["face_gap_tolerance"] = self.face_gap_tolerance
+            if self.bond_friction >= 0.0:
+                bonds["bond_friction"] = self.bond_friction
         contact = {"friction": self.friction, "rolling_friction": self.rolling_friction}
         if tie_contact_modulus:
             contact["youngs_modulus_GPa"] = self.contact_modulus_ratio * self.youngs_modulus_GPa
@@ -1321,6 +1327,7 @@ TABLE_COLUMNS = [
     "eval", "key", "ok", "error", "youngs_modulus_GPa", "tensile_strength_MPa", "shear_strength_MPa", "friction",
     "rolling_friction", "radius_multiplier", "gap_tolerance", "contact_modulus_ratio", "clump_size",
     *OPTIONAL_BOND_FIELDS, "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
+    "bond_friction",
     "ucs_Pa", "bts_Pa", "E_Pa", "ucs_error_1",
     "bts_error_1", "E_error_1", "ucs_to_bts_1", "ucs_to_E_pct", "ucs_strain_at_peak_1",
     "bts_broken_at_peak_1", "bts_cv_1", "bts_reading", "bts_peak_Pa", "bts_split_Pa", "wall_s", "engine_runs",

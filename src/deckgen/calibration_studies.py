@@ -483,6 +483,8 @@ def _bond_law(bonds: dict[str, Any]) -> str:
     extra = [f"β {bonds['moment_contribution']:g}"] if "moment_contribution" in bonds else []
     if bonds.get("joint_friction", 0.5) != 0.5:
         extra.append(f"μ {bonds['joint_friction']:g}")
+    if "bond_friction" in bonds:  # the intact bond's own friction (the broken face keeps joint_friction)
+        extra.append(f"intact μ {bonds['bond_friction']:g}")
     return ", ".join(["flat joint", *extra])
 
 

@@ -524,6 +524,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         ctx["flat_joint"] = {"library": plugin, "broken_file": FLAT_JOINT_BROKEN, "coeffs": coeffs,
                              "slit_type": slit_type, "gapped_type": gapped_type,
                              "elements": [b.face_sectors, b.face_rings] if b.face_sectors > 1 else []}
+        if b.bond_friction is not None:  # the plugin's 13th argument, after the slit flag, sectors and rings
+            ctx["flat_joint"]["elements"] = [b.face_sectors, b.face_rings, b.bond_friction]
     derived: dict[str, Any] = {
         "dt_s": dt, "dt_bond_s": dt_info["dt_s"], "dt_contact_s": dt_contact,
         "omega_translational_rad_s": dt_info["omega_translational_rad_s"],

@@ -875,7 +875,7 @@ def _render_platen_bonded(case: Case, out: str | Path) -> dict[str, Any]:
     E_b = b.youngs_modulus_GPa * GPA
     unsupported = [f"bonds.{n}" for n in ("clump_size", "unbonded_fraction", "bending_strength_factor",
                                           "twisting_strength_factor", "strength_weibull_modulus", "model",
-                                          "joint_friction", "moment_contribution")
+                                          "joint_friction", "moment_contribution", "bond_friction")
                    if getattr(b, n) != type(b).model_fields[n].default]
     if unsupported:  # bond/gran bonds every grain pair in range with one bond type: none of these maps onto it
         raise SpecError(f"case {case.name}: the LIGGGHTS bonded deck (one bond/gran type for all pairs) cannot express "

@@ -198,6 +198,14 @@ class Bonds(_Model):
         description="flat_joint only: friction coefficient of the intact bond's Mohr-Coulomb shear strength and of "
         "the broken face. Written to spec.json only when not 0.5.",
     )
+    bond_friction: float | None = Field(
+        None, ge=0, le=5, exclude_if=lambda v: v is None, json_schema_extra={"unit": "1"},
+        description="flat_joint only: friction coefficient of the intact bond's Mohr-Coulomb shear strength "
+        "(shear_strength_MPa + bond_friction x compression) when it differs from the broken face's joint_friction "
+        "(PFC's flat joint keeps the two apart too: a bonded friction angle and a residual friction). Unset: "
+        "joint_friction for both. A small value lowers the bond's strength under confinement, such as beneath a "
+        "cutter (docs/families.md). Written to spec.json only when set.",
+    )
 
     @model_validator(mode="after")
     def _clumps(self) -> "Bonds":
@@ -232,6 +240,8 @@ class Bonds(_Model):
                 raise ValueError("moment_contribution: used by the one-element face only; a face of elements "
                                  "resolves the moments itself (fix: remove moment_contribution, or face_sectors: 1)")
         else:
+            if self.bond_friction is not None:
+                raise ValueError("bond_friction: used only by model: flat_joint (fix: remove it, or model: flat_joint)")
             for field, value, plain in (("joint_friction", self.joint_friction, 0.5),
                                         ("moment_contribution", self.moment_contribution, 1.0),
                                         ("face_sectors", self.face_sectors, 1), ("face_rings", self.face_rings, 1),

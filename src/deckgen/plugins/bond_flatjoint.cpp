@@ -21,7 +21,8 @@
      twist    M_t += -k_s J (w_rel . n) dt           (incremental, about n)
      bending  M_b += -k_n I (w_rel - (w_rel.n) n) dt
    Intact: tensile failure if f_n/A + beta |M_b| R_b / I >= sigma_c; shear failure if
-   |F_s|/A + beta |M_t| R_b / J >= c + mu * max(0, -f_n/A); beta is the moment-contribution factor of
+   |F_s|/A + beta |M_t| R_b / J >= c + mu_b * max(0, -f_n/A); mu_b is the intact bond's friction (by default mu,
+   the broken face's; PFC's flat joint also keeps the two apart); beta is the moment-contribution factor of
    PFC's parallel bond (1: the moments load the bond's rim fully; 0: only forces break bonds).
    Broken: no tension (f_n = 0 and all loads reset while the face is open), in compression
    |F_s| <= mu |f_n|, |M_b| <= |f_n| R_b, |M_t| <= mu |f_n| 2 R_b / 3 (uniform pressure on the face).
@@ -39,7 +40,7 @@
    face plane) of area A_e = A/(rings sectors):
      normal   f_e = k_n A_e (r - r0 + theta_b . (p_e x n))    theta_b: relative bending rotation, j to i
      shear    F_e += -k_s A_e (v_t + w_t n x p_e) dt
-   Bonded element: tension break if f_e/A_e >= sigma_c, shear break if |F_e|/A_e >= c + mu max(0, -f_e/A_e).
+   Bonded element: tension break if f_e/A_e >= sigma_c, shear break if |F_e|/A_e >= c + mu_b max(0, -f_e/A_e).
    Unbonded element (broken, or slit): no tension (open: no load), |F_e| <= mu |f_e| in compression.
    The joint's force is the sum of the element forces, its moment sum p_e x (element force), so a face that
    has lost some elements still resists bending with the rest, and a broken face rocks about its elements.
@@ -47,8 +48,9 @@
    last bonded element breaks (mode: that element's).
 
    Syntax:  bond_style deckgen/flatjoint FILE          (FILE: broken bonds, one line each, appended)
-            bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings]]
-            (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1/2; sectors 1 (one element, the law above) or 3-16; rings 1-4)
+            bond_coeff T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings [mu_b]]]
+            (SI: Pa, -, -, Pa, Pa, -, -, -; slit 0/1/2; sectors 1 (one element, the law above) or 3-16; rings 1-4;
+            mu_b >= 0, the intact bond's friction, mu when not given)
    A bond type with slit 1 holds faces that are broken from the start: closed, cohesionless contacts with the
    broken face's law (the slit elements of Potyondy's flat joint); they are neither counted nor listed as breaks.
    Slit 2: gapped faces, also unbonded from the start but with the reference length r0 = r_i + r_j (the grains
@@ -185,13 +187,15 @@ class BondFlatJoint : public Bond {
 
   void coeff(int narg, char **arg) override
   {
-    if (narg != 9 && narg != 10 && narg != 12)
-      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings]]");
+    if (narg != 9 && narg != 10 && narg != 12 && narg != 13)
+      error->all(FLERR, "bond_coeff for deckgen/flatjoint: T E_b kappa lambda sigma_c c mu zeta beta [slit [sectors rings [mu_b]]]");
     if (!allocated) allocate();
     int ilo, ihi;
     utils::bounds(FLERR, arg[0], 1, atom->nbondtypes, ilo, ihi, error);
-    double v[NCOEFF] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1};
+    double v[NCOEFF] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, -1};
     for (int k = 0; k < narg - 1; k++) v[k] = utils::numeric(FLERR, arg[k + 1], false, lmp);
+    if (narg == 13 && v[11] < 0.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: mu_b must be >= 0");
+    if (narg < 13) v[11] = v[5];    // the intact bond's friction: the broken face's unless given
     if (v[7] < 0.0 || v[7] > 1.0) error->all(FLERR, "bond_coeff for deckgen/flatjoint: beta must be in [0, 1]");
     if (v[8] != 0.0 && v[8] != 1.0 && v[8] != 2.0)
       error->all(FLERR, "bond_coeff for deckgen/flatjoint: slit must be 0 (bonded), 1 (slit) or 2 (gapped)");
@@ -278,8 +282,8 @@ class BondFlatJoint : public Bond {
   }
 
  private:
-  static constexpr int NCOEFF = 11;
-  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta beta slit sectors rings
+  static constexpr int NCOEFF = 12;
+  double **coeffs = nullptr;    // per type: E_b kappa lambda sigma_c c mu zeta beta slit sectors rings mu_b
   std::string filename;
   FILE *out = nullptr;
   std::vector<Joint> joints;
@@ -389,7 +393,7 @@ class BondFlatJoint : public Bond {
       const double beta = c[7];
       const double sigma = fn / b.area + beta * norm3(b.mb) * b.rb / b.inertia;
       const double tau = norm3(b.fs) / b.area + beta * std::fabs(b.mt) * b.rb / b.polar;
-      const double tau_c = c[4] + mu * std::fmax(0.0, -fn / b.area);
+      const double tau_c = c[4] + c[11] * std::fmax(0.0, -fn / b.area);
       int mode = 0;
       if (sigma >= c[3]) mode = 1;
       else if (tau >= tau_c) mode = 2;
@@ -543,7 +547,7 @@ class BondFlatJoint : public Bond {
         const double sigma = fe / e.area, tau = norm3(e.fs) / e.area;
         int mode = 0;
         if (sigma >= sigma_c) mode = 1;
-        else if (tau >= coh + mu * std::fmax(0.0, -sigma)) mode = 2;
+        else if (tau >= coh + c[11] * std::fmax(0.0, -sigma)) mode = 2;
         if (mode) {
           e.bonded = false;
           b.nbonded--;

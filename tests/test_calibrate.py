@@ -198,7 +198,7 @@ def test_clump_fields_in_params_keys_and_overrides():
     # without clumps (and at the defaults of the later fields) the key is the one recorded before they existed
     later = ("unbonded_fraction", "bending_strength_factor", "twisting_strength_factor", "strength_weibull_modulus",
              "shrink_before_bonding", "flat_joint", "joint_friction", "moment_contribution", "face_sectors", "face_gap_tolerance",
-             "stiffness_ratio")
+             "stiffness_ratio", "bond_friction")
     old = {k: float(f"{v:.10g}") for k, v in asdict(p).items() if not k.startswith("clump_") and k not in later}
     assert p.key() == hashlib.sha1(json.dumps(old, sort_keys=True).encode()).hexdigest()[:16]
     assert "clump_size" not in p.overrides()["bonds"]

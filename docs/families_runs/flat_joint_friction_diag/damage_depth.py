@@ -8,7 +8,8 @@ its bonds at the start and at the end of the run). For each run the script gives
 grooves at +-12.5 mm), each as a share of all broken bond ends, with the share of the grains in the same region.
 Written here (not in deckgen.parse) because it serves this one comparison. damage_depth.csv: session 19, the
 90 000-step runs of lin_cardA_h24, lin_cardC_h24, lin_h24_w66, lin_cardC_h24_w66, lin_h24_nogrooves and
-lin_cardC_h24_nogrooves (the whole truncated run, not only the first event).
+lin_cardC_h24_nogrooves, lin_cardC_h24_nogrooves_d05 and lin_cardC_h24_nogrooves_v05 (the whole truncated run,
+not only the first event).
 """
 import sys
 

@@ -8,10 +8,11 @@ the run, and the fraction of the initial bonds broken 0.5, 1 and 2 mm of cutter 
 at the end of the (truncated) run. Written here
 (not in deckgen.parse) because it reads only the series file's three columns and serves this one comparison.
 
-The first 16 rows were written in session 18 (their run folders are not kept); the last six in session 19: the
+The first 16 rows were written in session 18 (their run folders are not kept); the last eight in session 19: the
 24 mm blocks with the cards A and C (lin_cardA_h24.yaml, lin_cardC_h24.yaml), the 24 mm x 66 mm blocks with the
 card and card C (lin_h24_w66.yaml, lin_cardC_h24_w66.yaml) and the 24 mm blocks without neighbour grooves
-(lin_h24_nogrooves.yaml, lin_cardC_h24_nogrooves.yaml), appended with
+(lin_h24_nogrooves.yaml, lin_cardC_h24_nogrooves.yaml; with card C also at bond damping 0.5 and at 0.5 m/s,
+lin_cardC_h24_nogrooves_d05.yaml, lin_cardC_h24_nogrooves_v05.yaml), appended with
 `python first_event.py LABEL=RUN_DIR ... | tail -n +2 >> first_event.csv`. Their packing has 22 677 initial bonds
 against 22 638 in the session-18 24 mm runs; lin_h24.yaml, rendered again in session 19, also gives 22 677, so the
 session-18 24 mm packing differed by 0.2 % of its bonds (cause not traced).

@@ -66,6 +66,24 @@ def test_packing_is_dense_jammed_and_cached(cache):
     assert (folder / "packing.json").stat().st_mtime_ns == stamp
 
 
+def test_packing_does_not_depend_on_the_runs_ranks(tmp_path):
+    """A case's packing is made on packing.ranks (1) MPI ranks whatever the run's command asks for. Packed on 2 ranks
+    (packing.ranks: 2, its own cache key) the same grains end elsewhere, so the command's ranks would matter."""
+    case = load_case(CASES / "tiny_ucs.yaml")
+    one = ensure_packing(case, tmp_path / "run1", progress=False, command=engine_command(1))
+    two = ensure_packing(case, tmp_path / "run2", progress=False, command=engine_command(2))
+    assert one.name == two.name
+    assert (one / "packed.data").read_bytes() == (two / "packed.data").read_bytes()
+    assert json.loads((two / "packing.json").read_text())["command"] == ["lmp"]
+    on2 = case.model_copy(update={"packing": case.packing.model_copy(update={"ranks": 2})})
+    other = ensure_packing(on2, tmp_path / "pk2", progress=False, command=engine_command(1))
+    assert other.name != one.name
+    assert json.loads((other / "packing.json").read_text())["command"] == ["mpirun", "-np", "2", "lmp"]
+    a, b = load_packing(one)[0], load_packing(other)[0]
+    assert len(a) == len(b)  # the same radii are drawn; the positions differ
+    assert not np.allclose(a.x, b.x, atol=1e-9)
+
+
 def test_tiny_ucs_peak_and_post_peak_breakage(ucs_run):
     out, spec, res = ucs_run
     s = read_series(out / "series.txt")

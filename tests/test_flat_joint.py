@@ -21,7 +21,7 @@ from deckgen.calibrate import MicroParams
 from deckgen.deck import FLAT_JOINT_BROKEN, render_case
 from deckgen.parse import ParseError
 from deckgen.results import _read_broken_joints, parse_run
-from deckgen.runner import engine_available, engine_command, engine_env, limit_ranks, run_deck
+from deckgen.runner import engine_available, engine_command, engine_env, limit_ranks, run_deck, set_ranks
 from deckgen.spec import SpecError, load_case, resolved_dict
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -363,6 +363,17 @@ def test_tiny_ucs_with_flat_joints_runs_and_reports_modes(tmp_path, slits, secto
     assert s["n_bonds_initial"] == spec["derived"]["n_bonds"]
     first = pd.read_csv(tmp_path / "parsed" / "timeseries.csv")["bonds_broken"].iloc[0]
     assert first == 0  # the slit faces are not breaks
+
+
+def test_set_ranks_sets_deckgens_own_form_and_keeps_user_commands(tmp_path):
+    assert set_ranks(["/v/bin/mpirun", "-np", "2", "/v/bin/lmp"], 1) == ["/v/bin/lmp"]
+    assert set_ranks(["/v/bin/mpirun", "-np", "1", "/v/bin/lmp"], 3) == ["/v/bin/mpirun", "-np", "3", "/v/bin/lmp"]
+    assert set_ranks(["srun", "-n", "4", "lmp"], 1) == ["srun", "-n", "4", "lmp"]  # the user's launcher
+    (tmp_path / "lmp").touch()
+    assert set_ranks([str(tmp_path / "lmp")], 2) == [str(tmp_path / "lmp")]  # no mpirun beside it
+    (tmp_path / "mpirun").touch()
+    assert set_ranks([str(tmp_path / "lmp")], 2) == [str(tmp_path / "mpirun"), "-np", "2", str(tmp_path / "lmp")]
+    assert set_ranks([str(tmp_path / "lmp")], 1) == [str(tmp_path / "lmp")]
 
 
 def test_limit_ranks_drops_deckgens_own_mpirun_and_keeps_user_commands():

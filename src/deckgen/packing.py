@@ -1,6 +1,6 @@
 """Dense polydisperse packings made by the engine, cached by a hash of their inputs.
 
-Algorithm (documented in docs/packing.md):
+Algorithm (documented in docs/model.md, "Packing"):
 1. Radii are drawn uniformly in [r_min, r_max] (seeded) until the grain volume reaches
    ``solid_fraction_target`` x specimen volume.
 2. Grains are placed at random inside the specimen at ``insertion_scale`` of their size; overlapping
@@ -42,7 +42,9 @@ from deckgen.render import render
 from deckgen.spec import GPA, MM, BrazilianDisc, Case, CuttingBlock, UcsCylinder
 
 PACK_DECK = "in.pack"
-PACKING_FORMAT = 3  # bump when the packing algorithm changes, so caches are not reused
+PACKING_FORMAT = 4  # bump when the packing algorithm changes, so caches are not reused
+# 4: packings are made on packing.ranks MPI ranks (default 1) whatever the run uses; format 3 caches could hold
+#    packings made on 2 ranks under the same key, which differ from 1-rank ones (docs/model.md, "Packing")
 
 
 @dataclass
@@ -292,19 +294,24 @@ def ensure_packing(case: Case, root: Path | None = None, *, progress: bool = Tru
 
 
 def _make_packing(case: Case, folder: Path, *, progress: bool, command: list[str] | None) -> Path:
-    from deckgen.runner import run_deck
+    from deckgen.runner import engine_command, run_deck, set_ranks
 
     tmp = folder.with_name(folder.name + ".tmp")
     if tmp.exists():
         shutil.rmtree(tmp)
     ctx = render_pack(case, tmp)
-    result = run_deck(tmp, PACK_DECK, expected_steps=ctx["expected_steps"], progress=progress, command=command,
+    # The domain decomposition changes the packing (lin_red_s100_p6p4: 2388 grains on 1 rank, 2384 on 2), so the
+    # packing runs on packing.ranks whatever the run's command asks for; a user's own launcher is kept as given.
+    ranks = case.packing.ranks
+    cmd = set_ranks(list(command) if command else engine_command(ranks), ranks)
+    result = run_deck(tmp, PACK_DECK, expected_steps=ctx["expected_steps"], progress=progress, command=cmd,
                       label=f"pack {case.name}")
     atoms = read_sphere_data(tmp / "packed.data")
     stats = asdict(packing_stats(atoms, specimen_region(case).volume_m3))
     stats.update(deflation_result(tmp / "log.lammps"))
     info = {"key": packing_key(case), "inputs": packing_inputs(case), "stats": stats,
-            "engine": {k: v for k, v in result.as_dict().items() if k not in ("run_dir", "command")}}
+            "engine": {k: v for k, v in result.as_dict().items() if k not in ("run_dir", "command")},
+            "command": [Path(c).name for c in cmd]}
     (tmp / "packing.json").write_text(json.dumps(info, indent=2, sort_keys=True) + "\n")
     if folder.exists():
         shutil.rmtree(folder)

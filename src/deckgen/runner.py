@@ -57,6 +57,18 @@ def engine_command(ranks: int | None = None, engine: str = "lammps") -> list[str
     return [str(lmp)]
 
 
+def set_ranks(cmd: list[str], ranks: int) -> list[str]:
+    """``cmd`` on exactly ``ranks`` MPI ranks, when it is deckgen's own form (``mpirun -np N lmp``, or a lone binary
+    with ``mpirun`` beside it). A command of another shape (``srun ...``, a user's wrapper) is returned unchanged."""
+    if len(cmd) >= 4 and Path(cmd[0]).name in ("mpirun", "mpiexec") and cmd[1] == "-np" and cmd[2].isdigit():
+        return cmd[3:] if ranks <= 1 else [cmd[0], "-np", str(ranks), *cmd[3:]]
+    if len(cmd) == 1 and ranks > 1:
+        mpirun = Path(cmd[0]).parent / "mpirun"
+        if mpirun.exists():
+            return [str(mpirun), "-np", str(ranks), cmd[0]]
+    return list(cmd)
+
+
 def limit_ranks(cmd: list[str], max_ranks: int) -> list[str]:
     """``cmd`` with at most ``max_ranks`` MPI ranks, when it is deckgen's own ``mpirun -np N lmp`` form.
 

@@ -57,7 +57,7 @@ class Material(_Model):
 # --------------------------------------------------------------------------- packing
 class Packing(_Model):
     """Dense polydisperse packing made by the engine: random insertion at reduced size, radius
-    growth inside frictionless walls with viscous drag, relaxation (see docs/packing.md)."""
+    growth inside frictionless walls with viscous drag, relaxation (see docs/model.md, "Packing")."""
 
     radius_min_mm: float = _f(0.6, "mm", "Smallest grain radius.", gt=0)
     radius_max_mm: float = _f(1.0, "mm", "Largest grain radius.", gt=0)
@@ -80,6 +80,12 @@ class Packing(_Model):
         gt=0, lt=0.05,
     )
     max_deflate_steps: int = _f(40, "1", "Deflation steps at most (then the packing is reported as is).", ge=0, le=500)
+    ranks: int = Field(
+        1, ge=1, le=4096, exclude_if=lambda v: v == 1, json_schema_extra={"unit": "1"},
+        description="MPI ranks the packing is made on, whatever the run uses: the domain decomposition changes the "
+        "packing (one case packed on 1 and on 2 ranks gave 2388 and 2384 grains), so a case file fixes its packing. "
+        "Raise it only for packings too big for one rank. A user's own engine command (--engine-cmd, DECKGEN_LMP) is "
+        "used as given. Left out of spec.json and the packing key at 1.")
 
     @model_validator(mode="after")
     def _radii(self) -> "Packing":

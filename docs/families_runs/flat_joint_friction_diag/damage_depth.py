@@ -9,7 +9,9 @@ grooves at +-12.5 mm), each as a share of all broken bond ends, with the share o
 Written here (not in deckgen.parse) because it serves this one comparison. damage_depth.csv: session 19, the
 90 000-step runs of lin_cardA_h24, lin_cardC_h24, lin_h24_w66, lin_cardC_h24_w66, lin_h24_nogrooves and
 lin_cardC_h24_nogrooves, lin_cardC_h24_nogrooves_d05 and lin_cardC_h24_nogrooves_v05 (the whole truncated run,
-not only the first event).
+not only the first event). Session 20 appended three runs of the 12 mm family block (whose top 6 mm is half of
+it): the card on the family packing (the family case itself) and with grains r 0.35-0.5 mm on two packings
+(lin_fine_grains.yaml, lin_fine_grains_seed202.yaml).
 """
 import sys
 

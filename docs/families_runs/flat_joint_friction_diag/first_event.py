@@ -16,7 +16,15 @@ card and card C (lin_h24_w66.yaml, lin_cardC_h24_w66.yaml) and the 24 mm blocks 
 lin_cardC_h24_nogrooves_d05.yaml, lin_cardC_h24_nogrooves_v05.yaml), appended with
 `python first_event.py LABEL=PARSED_DIR ... | tail -n +2 >> first_event.csv`. Their packing has 22 677 initial bonds
 against 22 638 in the session-18 24 mm runs; lin_h24.yaml, rendered again in session 19, also gives 22 677, so the
-session-18 24 mm packing differed by 0.2 % of its bonds (cause not traced).
+session-18 24 mm packing differed by 0.2 % of its bonds. Session 20 traced it: session 18 packed on 1 MPI rank and session
+19 on 2 (the packing then took the run's ranks); those eight case files now set packing.ranks: 2.
+
+Nine rows from session 20 (the family case lin_red_s100_p6p4, 12 mm block) follow: the card packed on 2 ranks
+(lin_ranks2.yaml) and on packing seed 202 (lin_seed202.yaml), card C on the family packing (lin_cardC.yaml), the card
+with moment_contribution 1 and with faces of 4 elements (lin_beta1_ranks2.yaml, lin_elem4_ranks2.yaml), and the card and
+card C with an unbreakable base below 6.4 mm (lin_frame_ranks2.yaml, lin_cardC_frame_ranks2.yaml; frame_base.py).
+Then two with grains r 0.35-0.5 mm on two packings (lin_fine_grains.yaml, lin_fine_grains_seed202.yaml; 175 000 steps).
+The first granite row (the card, 1-rank packing) was reproduced exactly by the family case rendered in session 20.
 """
 import sys
 

@@ -1,0 +1,44 @@
+"""Case files of the toughness diagnostic (session 21): a Brazilian disc and a cracked one per granite card.
+
+Usage: python make_cases.py OUT_DIR [PACKING_SEED]
+
+For each calibrated granite card (the coarse one, grains r 0.8-1.333 mm, cases/materials/colorado_red_granite.yaml,
+and the fine one, r 0.6-1.0 mm, docs/calibration_runs/colorado_red_granite_fine_card.yaml) it writes the case that
+the card's calibration runs as its Brazilian test (same bonds, contact, packing, jaws, platen speed from
+loading_transits, stop rule), but on a disc of 40 mm diameter and 10 mm thickness instead of 20 x 10 mm, so that a
+central crack of 2a = 16 mm (a/R = 0.4) spans 6-10 grain diameters. The crack itself is cut by notch.py after
+rendering (a case file cannot name bonds). Written here, not as a specimen kind, because it serves this one question:
+the bonded granite's fracture toughness at the two grain sizes (docs/families.md, "The fracture toughness of the
+granite cards").
+With PACKING_SEED the same cases on another packing, named kic_<card>_s<seed>.
+"""
+import sys
+from pathlib import Path
+
+import yaml
+
+from deckgen.calibrate import DemEvaluator
+from deckgen.calibration_studies import _card_setup
+
+ROOT = Path(__file__).resolve().parents[3]
+CARDS = {"coarse": ROOT / "cases/materials/colorado_red_granite.yaml",
+         "fine": ROOT / "docs/calibration_runs/colorado_red_granite_fine_card.yaml"}
+out = Path(sys.argv[1])
+seed = int(sys.argv[2]) if len(sys.argv) > 2 else None
+out.mkdir(parents=True, exist_ok=True)
+for label, path in CARDS.items():
+    card, p, base, ucs, bts = _card_setup(path)
+    disc = {**bts, "diameter_mm": 40.0, "thickness_mm": 10.0}
+    ev = DemEvaluator(base, ucs, disc, out / "unused", name=f"kic_{label}", bts_reading=card.calibration.bts_reading)
+    case = ev.case(p, "bts")
+    name = f"kic_{label}" if seed is None else f"kic_{label}_s{seed}"
+    if seed is not None:
+        case = case.model_validate({**case.model_dump(mode="json"), "packing": {**case.packing.model_dump(mode="json"),
+                                                                               "seed": seed}})
+    data = case.model_dump(mode="json", exclude_defaults=True)
+    data["name"] = name
+    data["specimen"] = {"kind": "brazilian_disc", **data["specimen"]}  # a default, but the discriminator
+    head = (f"# toughness diagnostic (docs/families_runs/toughness_diag/make_cases.py): the Brazilian test of\n"
+            f"# {path.relative_to(ROOT)} on a 40 x 10 mm disc; notch.py cuts the crack after rendering.\n")
+    (out / f"{name}.yaml").write_text(head + yaml.safe_dump(data, sort_keys=False, width=120))
+    print(out / f"{name}.yaml", case.packing.seed, disc)

@@ -1,6 +1,6 @@
 """Case files of the toughness diagnostic (session 21): a Brazilian disc and a cracked one per granite card.
 
-Usage: python make_cases.py OUT_DIR [PACKING_SEED]
+Usage: python make_cases.py OUT_DIR [PACKING_SEED] [CARD ...]   (coarse, fine, card_a, card_c; default coarse fine)
 
 For each calibrated granite card (the coarse one, grains r 0.8-1.333 mm, cases/materials/colorado_red_granite.yaml,
 and the fine one, r 0.6-1.0 mm, docs/calibration_runs/colorado_red_granite_fine_card.yaml) it writes the case that
@@ -10,7 +10,10 @@ central crack of 2a = 16 mm (a/R = 0.4) spans 6-10 grain diameters. The crack it
 rendering (a case file cannot name bonds). Written here, not as a specimen kind, because it serves this one question:
 the bonded granite's fracture toughness at the two grain sizes (docs/families.md, "The fracture toughness of the
 granite cards").
-With PACKING_SEED the same cases on another packing, named kic_<card>_s<seed>.
+With PACKING_SEED the same cases on another packing, named kic_<card>_s<seed> (0: the cards' own seed).
+The cards card_a and card_c (A and C in docs/families.md) are the granite cards calibrated without the intact bond's
+friction (docs/families.md, "Why the calibrated granite breaks up the reduced block"): same grains and targets as the
+coarse card, cohesion 140 and 126 MPa instead of 70.
 """
 import sys
 from pathlib import Path
@@ -22,11 +25,18 @@ from deckgen.calibration_studies import _card_setup
 
 ROOT = Path(__file__).resolve().parents[3]
 CARDS = {"coarse": ROOT / "cases/materials/colorado_red_granite.yaml",
-         "fine": ROOT / "docs/calibration_runs/colorado_red_granite_fine_card.yaml"}
+         "fine": ROOT / "docs/calibration_runs/colorado_red_granite_fine_card.yaml",
+         "card_a": ROOT / "docs/calibration_runs/colorado_red_granite_joint_friction0_card.yaml",
+         "card_c": ROOT / "docs/calibration_runs/colorado_red_granite_intact_friction0_face0p5_card.yaml"}
 out = Path(sys.argv[1])
-seed = int(sys.argv[2]) if len(sys.argv) > 2 else None
+seed = int(sys.argv[2]) if len(sys.argv) > 2 and sys.argv[2] != "0" else None
+chosen = sys.argv[3:] or ["coarse", "fine"]
+unknown = sorted(set(chosen) - set(CARDS))
+if unknown:
+    raise SystemExit(f"make_cases.py: unknown card(s) {unknown} (fix: choose from {sorted(CARDS)})")
 out.mkdir(parents=True, exist_ok=True)
-for label, path in CARDS.items():
+for label in chosen:
+    path = CARDS[label]
     card, p, base, ucs, bts = _card_setup(path)
     disc = {**bts, "diameter_mm": 40.0, "thickness_mm": 10.0}
     ev = DemEvaluator(base, ucs, disc, out / "unused", name=f"kic_{label}", bts_reading=card.calibration.bts_reading)

@@ -13,7 +13,8 @@ granite cards").
 With PACKING_SEED the same cases on another packing, named kic_<card>_s<seed> (0: the cards' own seed).
 The cards card_a and card_c (A and C in docs/families.md) are the granite cards calibrated without the intact bond's
 friction (docs/families.md, "Why the calibrated granite breaks up the reduced block"): same grains and targets as the
-coarse card, cohesion 140 and 126 MPa instead of 70.
+coarse card, cohesion 140 and 126 MPa instead of 70. CARD@D (e.g. coarse@80) writes a disc of D mm instead of 40,
+named kic_<card>_d<D>[_s<seed>] (the size effect of the intact disc).
 """
 import sys
 from pathlib import Path
@@ -30,18 +31,18 @@ CARDS = {"coarse": ROOT / "cases/materials/colorado_red_granite.yaml",
          "card_c": ROOT / "docs/calibration_runs/colorado_red_granite_intact_friction0_face0p5_card.yaml"}
 out = Path(sys.argv[1])
 seed = int(sys.argv[2]) if len(sys.argv) > 2 and sys.argv[2] != "0" else None
-chosen = sys.argv[3:] or ["coarse", "fine"]
-unknown = sorted(set(chosen) - set(CARDS))
+chosen = [arg.partition("@") for arg in sys.argv[3:] or ["coarse", "fine"]]
+unknown = sorted({label for label, _, _ in chosen} - set(CARDS))
 if unknown:
     raise SystemExit(f"make_cases.py: unknown card(s) {unknown} (fix: choose from {sorted(CARDS)})")
 out.mkdir(parents=True, exist_ok=True)
-for label in chosen:
+for label, _, diameter in chosen:
     path = CARDS[label]
     card, p, base, ucs, bts = _card_setup(path)
-    disc = {**bts, "diameter_mm": 40.0, "thickness_mm": 10.0}
+    disc = {**bts, "diameter_mm": float(diameter or 40.0), "thickness_mm": 10.0}
     ev = DemEvaluator(base, ucs, disc, out / "unused", name=f"kic_{label}", bts_reading=card.calibration.bts_reading)
     case = ev.case(p, "bts")
-    name = f"kic_{label}" if seed is None else f"kic_{label}_s{seed}"
+    name = f"kic_{label}" + (f"_d{float(diameter):g}" if diameter else "") + ("" if seed is None else f"_s{seed}")
     if seed is not None:
         case = case.model_validate({**case.model_dump(mode="json"), "packing": {**case.packing.model_dump(mode="json"),
                                                                                "seed": seed}})
@@ -49,6 +50,7 @@ for label in chosen:
     data["name"] = name
     data["specimen"] = {"kind": "brazilian_disc", **data["specimen"]}  # a default, but the discriminator
     head = (f"# toughness diagnostic (docs/families_runs/toughness_diag/make_cases.py): the Brazilian test of\n"
-            f"# {path.relative_to(ROOT)} on a 40 x 10 mm disc; notch.py cuts the crack after rendering.\n")
+            f"# {path.relative_to(ROOT)} on a {disc['diameter_mm']:g} x 10 mm disc; notch.py cuts the crack after "
+            f"rendering.\n")
     (out / f"{name}.yaml").write_text(head + yaml.safe_dump(data, sort_keys=False, width=120))
     print(out / f"{name}.yaml", case.packing.seed, disc)

@@ -16,10 +16,11 @@ summary.json. Per run:
   tension 2P/(pi D t) x sqrt(pi a)), with the geometry factor N_I of their tables for the loading angle 0: about
   1.06 at a/R = 0.4 and 1.15 at a/R = 0.6 (the disc's R is 20 mm).
 The later rise of the load, while the jaws crush the split halves, is not read.
-toughness.csv (session 21): 26 runs, rendered with `deckgen render CASE --out RUN --ranks 1` and run with
+toughness.csv (session 21): 29 runs, rendered with `deckgen render CASE --out RUN --ranks 1` and run with
 `deckgen run RUN --ranks 1`. Per card (coarse, fine, card_a, card_c): the packings 12345 (kic_<card>.yaml), 202 and
 303 (kic_<card>_s<seed>.yaml), each intact and after `python notch.py RUN 8`; for coarse and fine also
-kic_<card>.yaml after `python notch.py RUN 12`. The rows of cards A and C were appended last.
+kic_<card>.yaml after `python notch.py RUN 12`. Then the rows of cards A and C, and last three intact 80 mm discs of
+the coarse card (kic_coarse_d80[_s<seed>].yaml; their decks' nchunks cut to 46 by hand, past the split).
 Written here, not in deckgen.parse, because it serves this one diagnostic.
 """
 import json

@@ -13,14 +13,13 @@ import re
 import sys
 from pathlib import Path
 
+from deckgen.datafile import iter_section
+
 run, depth = Path(sys.argv[1]), float(sys.argv[2]) * 1e-3
+# rock grains (type 1) of the bpm/sphere Atoms section: id mol type diameter density x y z
+z = {int(f[0]): float(f[7]) for _, f in iter_section(run / "specimen.data", "Atoms") if f[2] == "1"}
 lines = (run / "specimen.data").read_text().splitlines()
-i_atoms, i_bonds = lines.index("Atoms # bpm/sphere"), lines.index("Bonds")
-z = {}
-for line in lines[i_atoms + 2:i_bonds]:
-    f = line.split()
-    if f and f[2] == "1":  # rock grains: id mol type diameter density x y z
-        z[int(f[0])] = float(f[7])
+i_bonds = lines.index("Bonds")
 top = float(sys.argv[3]) * 1e-3 if len(sys.argv) > 3 else max(z.values())
 z_cut = top - depth
 i_types = next(k for k, line in enumerate(lines) if line.endswith("bond types"))

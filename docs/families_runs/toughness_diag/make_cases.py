@@ -23,6 +23,7 @@ import yaml
 
 from deckgen.calibrate import DemEvaluator
 from deckgen.calibration_studies import _card_setup
+from deckgen.spec import deep_merge
 
 ROOT = Path(__file__).resolve().parents[3]
 CARDS = {"coarse": ROOT / "cases/materials/colorado_red_granite.yaml",
@@ -39,13 +40,12 @@ out.mkdir(parents=True, exist_ok=True)
 for label, _, diameter in chosen:
     path = CARDS[label]
     card, p, base, ucs, bts = _card_setup(path)
+    if seed is not None:
+        base = deep_merge(base, {"packing": {"seed": seed}})
     disc = {**bts, "diameter_mm": float(diameter or 40.0), "thickness_mm": 10.0}
     ev = DemEvaluator(base, ucs, disc, out / "unused", name=f"kic_{label}", bts_reading=card.calibration.bts_reading)
     case = ev.case(p, "bts")
     name = f"kic_{label}" + (f"_d{float(diameter):g}" if diameter else "") + ("" if seed is None else f"_s{seed}")
-    if seed is not None:
-        case = case.model_validate({**case.model_dump(mode="json"), "packing": {**case.packing.model_dump(mode="json"),
-                                                                               "seed": seed}})
     data = case.model_dump(mode="json", exclude_defaults=True)
     data["name"] = name
     data["specimen"] = {"kind": "brazilian_disc", **data["specimen"]}  # a default, but the discriminator

@@ -26,6 +26,7 @@ Written here, not in deckgen.parse, because it serves this one diagnostic.
 import json
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -38,7 +39,7 @@ for arg in sys.argv[1:]:
     label, folder, a_mm = arg.split("=")
     a = float(a_mm) * 1e-3
     ts = pd.read_csv(f"{folder}/timeseries.csv")
-    summary = json.loads(open(f"{folder}/summary.json").read())
+    summary = json.loads(Path(folder, "summary.json").read_text())
     s, e, b = ts["stress_Pa"].to_numpy(), ts["strain_1"].to_numpy(), ts["bonds_broken"].to_numpy()
     n0 = float(ts["bonds_intact"].iloc[0])
     i_onset = int(np.argmax(b - b[0] >= ONSET_FRACTION * n0))

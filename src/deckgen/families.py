@@ -114,8 +114,9 @@ def calibrated_card(rock: str, path: Path | None = None) -> dict[str, Any] | Non
 
 def cutting_card_path(rock: str) -> Path:
     """The card the cutting families take for ``rock``: cases/materials/cutting/<rock>.yaml where the rock's card
-    does not cut (limestone since session 17: the flat-joint card shatters the reduced ODC block, docs/families.md),
-    else the rock's card cases/materials/<rock>.yaml."""
+    does not cut (limestone since session 17: the flat-joint card shatters the reduced ODC block; granite since
+    session 22: the flat-joint card breaks up the reduced linear block; docs/families.md), else the rock's card
+    cases/materials/<rock>.yaml."""
     from deckgen.render import repo_root
 
     materials = repo_root() / "cases" / "materials"
@@ -140,7 +141,10 @@ def rock_micro(rock: str, soften_to_GPa: float | None = None) -> tuple[dict[str,
     card = calibrated_card(rock, path)
     if card:
         b, c = dict(card["bonds"]), dict(card["contact"])
-        source = f"calibrated card {path.relative_to(repo_root()).as_posix()} (issue #3; calibrated at its own grain size)"
+        rel = path.relative_to(repo_root()).as_posix()
+        source = (f"calibrated card {rel} (issue #3; calibrated at its own grain size)" if path.parent.name != "cutting"
+                  else f"cutting card {rel} (calibrated at its own grain size; the rock's own card does not cut the "
+                       "reduced block: its header gives the targets and why)")
     else:
         k_e = ROCKS[rock]["youngs_modulus_GPa"] / SMOKE_E_GPA
         k_s = ROCKS[rock]["ucs_MPa"] / SMOKE_UCS_MPA

@@ -25,6 +25,8 @@ with moment_contribution 1 and with faces of 4 elements (lin_beta1_ranks2.yaml, 
 card C with an unbreakable base below 6.4 mm (lin_frame_ranks2.yaml, lin_cardC_frame_ranks2.yaml; frame_base.py).
 Then two with grains r 0.35-0.5 mm on two packings (lin_fine_grains.yaml, lin_fine_grains_seed202.yaml; 175 000 steps).
 The first granite row (the card, 1-rank packing) was reproduced exactly by the family case rendered in session 20.
+The last five rows (session 22) are the linear trend cases with the bpm/rotational cutting card
+(cases/materials/cutting/colorado_red_granite.yaml), full runs of the family cases through Snakemake.
 """
 import sys
 

@@ -702,3 +702,25 @@ def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
     # a longer family case wins over its prefix: odc_red_s11_long_x_y is a variant of odc_red_s11_long
     c = _variant_run(tmp_path, "odc_red_s11_long_nospin_bottom", 20.0, 90)
     assert list(fam.family_table(index, [c], variants=True)["case"]) == ["odc_red_s11_long"]
+
+
+def test_recorded_linear_runs_with_the_granite_cutting_card_give_the_documented_trends(tmp_path):
+    """docs/families_runs/linear_reduced_bpm_granite: the 16 reduced linear runs of session 22 (bpm granite cutting
+    card). Re-fitted from their family table, the trends are the ones docs/families.md reports: F_n rises with S
+    (+117 %, p 0.069) and F_r/F_n with p (+96 %, p 0.027; seed 001 +93 %); the cut breaks 8-35 % of the bonds."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite"
+    table = pd.read_csv(rec / "family_table.csv")
+    assert len(table) == 16 and table["broken_fraction_1"].between(0.08, 0.355).all()
+    rc = fam.main(["combine", "--family", "linear_ccs", "--index", str(ROOT / "cases/linear_ccs/index.csv"),
+                   "--out", str(tmp_path / "out"), str(rec / "family_table.csv")])
+    assert rc == 0
+    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend")
+    assert tr.loc["fn_rises_with_s", "change_1"] == pytest.approx(1.174, abs=1e-3)
+    assert tr.loc["fn_rises_with_s", "p_value"] == pytest.approx(0.069, abs=1e-3)
+    assert tr.loc["fr_fn_rises_with_p", "change_1"] == pytest.approx(0.958, abs=1e-3)
+    assert tr.loc["fr_fn_rises_with_p", "p_value"] == pytest.approx(0.027, abs=1e-3)
+    assert bool(tr.loc["fr_fn_rises_with_p", "sign_as_seed"]) and bool(tr.loc["fn_rises_with_s", "sign_as_seed"])
+    recorded = pd.read_csv(rec / "trends.csv").set_index("trend")
+    assert np.allclose(tr.loc[recorded.index, "slope"], recorded["slope"])

@@ -174,10 +174,8 @@ def test_family_bonds_keep_the_rocks_failure_strain_when_softened(monkeypatch):
     t = g["targets"]  # UCS/BTS 8 with UCS^2 BTS the rock's (158^2 x 6.78 MPa^3) and the rock's E
     assert t["ucs_MPa"] / t["bts_MPa"] == pytest.approx(8, rel=2e-3)
     assert t["ucs_MPa"] ** 2 * t["bts_MPa"] == pytest.approx(158**2 * 6.78, rel=2e-3) and t["youngs_modulus_GPa"] == 41
-    a = g["provenance"]["achieved"]  # converged: UCS, BTS and E within the card's tolerance, the discs split
+    # converged (that "converged" means within the tolerance with split discs: test_calibrate's card test)
     assert g["provenance"]["converged"] is True and g["calibration"]["bts_reading"] == "peak"
-    assert max(abs(a["ucs_error"]), abs(a["bts_error"]), abs(a["youngs_modulus_error"])) <= g["provenance"]["tolerance"]
-    assert a["bts_broken_at_peak"] <= g["provenance"]["bts_max_broken_at_peak"]
     gb = g["calibrated"]["bonds"]
     bg, cg, lg = fam.rock_micro("colorado_red_granite", soften_to_GPa=10)
     assert "model" not in bg and bg["youngs_modulus_GPa"] == 10

@@ -344,6 +344,36 @@ def test_cutting_frame_signs_and_steady_means(parsed):
     assert v == pytest.approx(spec["case"]["kinematics"]["speed_m_s"], rel=1e-6)
 
 
+def test_a_finished_cut_reads_again_over_another_steady_window(parsed, tmp_path, capsys):
+    """``deckgen parse --steady-window A B`` replaces the case's window for the means and records it; the peaks and the
+    series do not depend on it; a window that is not two ordered fractions, or one for a platen test, is refused."""
+    from deckgen.cli import main
+
+    base, _ = parsed["ref_cut"]
+    a0, b0 = _spec(CUT)["case"]["outputs"]["steady_window"]
+    assert (base["steady_window_start_1"], base["steady_window_end_1"], base["steady_window_source"]) == (a0, b0, "case")
+    a, b = 0.1, 0.5
+    assert (a, b) != (a0, b0)
+    assert main(["parse", str(CUT), "--out", str(tmp_path / "w"), "--steady-window", str(a), str(b)]) == 0
+    other = json.loads((tmp_path / "w" / "summary.json").read_text())
+    assert (other["steady_window_start_1"], other["steady_window_end_1"], other["steady_window_source"]) == (a, b, "parse")
+    raw = _raw_series(CUT)
+    dur = _spec(CUT)["derived"]["cutter"]["duration"]
+    t = raw["time_s"].to_numpy()
+    sel = (t >= a * dur) & (t <= b * dur)
+    assert other["steady_rows"] == sel.sum() != base["steady_rows"]
+    assert other["force_normal_N_mean_steady"] == pytest.approx(raw["force_z_N"][sel].mean(), rel=1e-12)
+    assert other["force_normal_N_mean_steady"] != pytest.approx(base["force_normal_N_mean_steady"], rel=1e-3)
+    assert other["force_normal_N_peak"] == base["force_normal_N_peak"]
+    assert other["bonds_broken"] == base["bonds_broken"]
+    capsys.readouterr()
+    assert main(["parse", str(CUT), "--out", str(tmp_path / "x"), "--steady-window", "0.6", "0.4"]) != 0
+    err = capsys.readouterr().err
+    assert "0.6 0.4" in err and "0 <= start < end <= 1" in err and "Traceback" not in err
+    assert main(["parse", str(UCS), "--out", str(tmp_path / "y"), "--steady-window", "0.1", "0.5"]) != 0
+    assert "for cutting runs" in capsys.readouterr().err
+
+
 # ----------------------------------------------------------------------------- column names
 @pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
 def test_tables_have_units_in_column_names(parsed, name):

@@ -135,9 +135,15 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_parse(args: argparse.Namespace) -> int:
-    from deckgen.results import parse_run
+    from deckgen.results import check_steady_window, parse_run
+    from deckgen.spec import SpecError
 
-    summary = parse_run(Path(args.dir), Path(args.out))
+    if args.steady_window is not None:
+        try:
+            check_steady_window(Path(args.dir), args.steady_window)
+        except ValueError as exc:
+            raise SpecError(f"--steady-window: {exc}") from None
+    summary = parse_run(Path(args.dir), Path(args.out), steady_window=args.steady_window)
     keys = [k for k in ("peak_stress_Pa", "youngs_modulus_Pa", "force_normal_N_mean_steady", "force_normal_N_peak",
                         "bonds_broken") if k in summary]
     print(f"{args.dir}: " + ", ".join(f"{k} {summary[k]:.4g}" for k in keys))
@@ -242,6 +248,9 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("parse", help="tables and summary of one run")
     s.add_argument("dir")
     s.add_argument("--out", required=True)
+    s.add_argument("--steady-window", nargs=2, type=float, metavar=("START", "END"), default=None,
+                   help="cutting runs: read the means over these fractions of the travel instead of the case's "
+                        "outputs.steady_window (the summary records the window and its source)")
     s.set_defaults(func=cmd_parse)
     s = sub.add_parser("aggregate", help="one table per kind across parsed runs")
     s.add_argument("dirs", nargs="+")

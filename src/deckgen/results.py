@@ -96,7 +96,7 @@ UNITLESS_COLUMNS = frozenset({
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
     "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
-    "notes", "log_failure",
+    "steady_window_source", "notes", "log_failure",
 })
 
 #: Suffixes that carry a unit (SI) in column names; ``_1`` = dimensionless.
@@ -853,8 +853,35 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
 
 
 # ----------------------------------------------------------------------------- parse_run
-def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
+def check_steady_window(run_dir: str | Path, window: Any, test: str | None = None) -> tuple[float, float]:
+    """The steady window ``window`` as two floats, or ValueError naming the run folder and the fix: it must be two
+    fractions 0 <= start < end <= 1 of the travel, for a cutting run (``test`` None: read from its spec.json)."""
+    run_dir = Path(run_dir)
+    try:
+        a, b = (float(x) for x in window)
+    except (TypeError, ValueError):
+        raise ValueError(f"{run_dir}: steady window {window!r} is not two numbers (fix: START END, e.g. 0.3 1.0)") from None
+    if not (0 <= a < b <= 1):
+        raise ValueError(f"{run_dir}: steady window {a:g} {b:g} is not two fractions 0 <= start < end <= 1 of the travel "
+                         "(fix: e.g. 0.3 1.0)")
+    if test is None:
+        spec_path = run_dir / "spec.json"
+        if not spec_path.is_file():
+            raise ValueError(f"{spec_path}: no spec.json (not a rendered run folder?)")
+        test = json.loads(spec_path.read_text())["case"].get("test")
+    if test != "cutting":
+        raise ValueError(f"{run_dir}: a steady window is for cutting runs; this run is a {test} test (fix: drop it)")
+    return a, b
+
+
+def parse_run(run_dir: str | Path, out_dir: str | Path,
+              steady_window: tuple[float, float] | None = None) -> dict[str, Any]:
     """Parse one run folder into tables in ``out_dir``; return the flat summary dict.
+
+    ``steady_window`` (cutting runs): fractions [a, b] of the travel that replace the case's
+    ``outputs.steady_window`` for the means, so a finished run can be read again over another window without
+    running it again; the summary keeps the window used (``steady_window_start_1``, ``steady_window_end_1``)
+    and where it came from (``steady_window_source``: ``case`` or ``parse``).
 
     Writes ``timeseries``, ``broken``, ``broken_timeseries`` and ``damage`` (``.parquet`` and
     ``.csv``) and ``summary.json``. Summary keys (all scalars; NaN in the dict, ``null`` in the
@@ -895,6 +922,9 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
     test = case.get("test")
     if test not in ("ucs", "bts", "cutting"):
         raise ValueError(f"{spec_path}: case.test is {test!r}, expected ucs, bts or cutting")
+    if steady_window is not None:
+        a, b = check_steady_window(run_dir, steady_window, test)
+        spec = {**spec, "derived": {**spec["derived"], "steady_window": [a, b]}}
     derived = spec["derived"]
     engine = spec.get("engine") or case.get("engine", "lammps")
     state = _RunState(run_dir)
@@ -980,6 +1010,9 @@ def parse_run(run_dir: str | Path, out_dir: str | Path) -> dict[str, Any]:
                                f"peak_stress_Pa is a lower bound, not a strength (fix: raise specimen.max_strain)")
     else:
         extra = _cutting_summary(ts, spec)
+        window = derived.get("steady_window") or case["outputs"]["steady_window"]
+        extra["steady_window_start_1"], extra["steady_window_end_1"] = float(window[0]), float(window[1])
+        extra["steady_window_source"] = "parse" if steady_window is not None else "case"
         note = extra.pop("notes_extra", None)
         if note:
             state.notes.append(note)

@@ -15,13 +15,13 @@ import pandas as pd
 PERIOD_S = 1.0 / 90.0
 
 
-def spread(run: Path) -> dict:
+def spread(run: Path, period_s: float = PERIOD_S) -> dict:
     s = json.loads((run / "parsed" / "summary.json").read_text())
     ts = pd.read_parquet(run / "parsed" / "timeseries.parquet", columns=["time_s", "force_magnitude_N"])
     t, f = ts["time_s"].to_numpy(), ts["force_magnitude_N"].to_numpy()
     t0, t1 = s["steady_start_s"], s["steady_end_s"]
-    starts = t[(t >= t0) & (t + PERIOD_S <= t1 + 1e-12)]
-    means = np.array([f[(t >= a) & (t < a + PERIOD_S)].mean() for a in starts])
+    starts = t[(t >= t0) & (t + period_s <= t1 + 1e-12)]
+    means = np.array([f[(t >= a) & (t < a + period_s)].mean() for a in starts])
     return {"run": run.name, "windows": len(means), "min": means.min(), "median": float(np.median(means)),
             "max": means.max(), "first": means[0]}
 

@@ -706,6 +706,20 @@ def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
     assert list(fam.family_table(index, [c], variants=True)["case"]) == ["odc_red_s11_long"]
 
 
+def _refit_recorded(family: str, rec: Path, tmp_path: Path):
+    """The trends of the recorded family table ``rec``/family_table.csv, re-fitted by `deckgen.families combine`; their
+    slopes must equal the recorded ``rec``/trends.csv."""
+    import pandas as pd
+
+    rc = fam.main(["combine", "--family", family, "--index", str(ROOT / "cases" / family / "index.csv"),
+                   "--out", str(tmp_path / "out"), str(rec / "family_table.csv")])
+    assert rc == 0
+    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend")
+    recorded = pd.read_csv(rec / "trends.csv").set_index("trend")
+    assert np.allclose(tr.loc[recorded.index, "slope"], recorded["slope"])
+    return tr
+
+
 def test_recorded_linear_runs_with_the_granite_cutting_card_give_the_documented_trends(tmp_path):
     """docs/families_runs/linear_reduced_bpm_granite: the 16 reduced linear runs of session 22 (bpm granite cutting
     card). Re-fitted from their family table, the trends are the ones docs/families.md reports: F_n rises with S
@@ -715,17 +729,12 @@ def test_recorded_linear_runs_with_the_granite_cutting_card_give_the_documented_
     rec = ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite"
     table = pd.read_csv(rec / "family_table.csv")
     assert len(table) == 16 and table["broken_fraction_1"].between(0.08, 0.355).all()
-    rc = fam.main(["combine", "--family", "linear_ccs", "--index", str(ROOT / "cases/linear_ccs/index.csv"),
-                   "--out", str(tmp_path / "out"), str(rec / "family_table.csv")])
-    assert rc == 0
-    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend")
+    tr = _refit_recorded("linear_ccs", rec, tmp_path)
     assert tr.loc["fn_rises_with_s", "change_1"] == pytest.approx(1.174, abs=1e-3)
     assert tr.loc["fn_rises_with_s", "p_value"] == pytest.approx(0.069, abs=1e-3)
     assert tr.loc["fr_fn_rises_with_p", "change_1"] == pytest.approx(0.958, abs=1e-3)
     assert tr.loc["fr_fn_rises_with_p", "p_value"] == pytest.approx(0.027, abs=1e-3)
     assert bool(tr.loc["fr_fn_rises_with_p", "sign_as_seed"]) and bool(tr.loc["fn_rises_with_s", "sign_as_seed"])
-    recorded = pd.read_csv(rec / "trends.csv").set_index("trend")
-    assert np.allclose(tr.loc[recorded.index, "slope"], recorded["slope"])
 
 
 def test_recorded_rotary_runs_over_the_wide_window_give_the_documented_trends(tmp_path):
@@ -742,16 +751,11 @@ def test_recorded_rotary_runs_over_the_wide_window_give_the_documented_trends(tm
         assert g["force_normal_N_mean_steady"].max() < 2 * g["force_normal_N_mean_steady"].min()
         by_r = g.set_index("rotary_radius_full_mm")["rolling_to_normal_ratio_1"]
         assert by_r[1000] < 0.8 * by_r[250]  # -24 % and -29 % in the two packings
-    rc = fam.main(["combine", "--family", "rotary", "--index", str(ROOT / "cases/rotary/index.csv"),
-                   "--out", str(tmp_path / "out"), str(rec / "family_table.csv")])
-    assert rc == 0
-    tr = pd.read_csv(tmp_path / "out" / "trends.csv").set_index("trend")
+    tr = _refit_recorded("rotary", rec, tmp_path)
     assert tr.loc["fr_fn_falls_with_r", "change_1"] == pytest.approx(-0.128, abs=1e-3)
     assert tr.loc["fr_fn_falls_with_r", "p_value"] == pytest.approx(0.060, abs=1e-3)
     assert bool(tr.loc["fr_fn_falls_with_r", "sign_as_seed"])
     assert tr.loc["fs_falls_with_r", "p_value"] == pytest.approx(0.773, abs=1e-3)
-    recorded = pd.read_csv(rec / "trends.csv").set_index("trend")
-    assert np.allclose(tr.loc[recorded.index, "slope"], recorded["slope"])
 
 
 def test_recorded_x1_smooth_cone_cuts_give_the_documented_ratios():

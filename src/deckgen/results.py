@@ -800,6 +800,7 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
         "kinematics_mode": d.get("kinematics_mode", spec["case"]["kinematics"]["mode"]),
         "cut_duration_s": duration, "steady_start_s": float(window[0]) * duration,
         "steady_end_s": float(window[1]) * duration, "cutter_radius_m": float(cut.get("radius", _nan())),
+        "steady_window_start_1": float(window[0]), "steady_window_end_1": float(window[1]),
         "cutter_speed_m_s": V, "eccentricity_m": ecc, "omega_rad_s": omega,
         "travel_m": float(cut.get("travel", _nan())), "penetration_m": float(cut.get("penetration", _nan())),
         "velocity_ratio_nu_1": V / (ecc * omega) if ecc > 0 and omega > 0 else _nan(),
@@ -853,24 +854,22 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
 
 
 # ----------------------------------------------------------------------------- parse_run
-def check_steady_window(run_dir: str | Path, window: Any, test: str | None = None) -> tuple[float, float]:
-    """The steady window ``window`` as two floats, or ValueError naming the run folder and the fix: it must be two
-    fractions 0 <= start < end <= 1 of the travel, for a cutting run (``test`` None: read from its spec.json)."""
-    run_dir = Path(run_dir)
+def _steady_window(run_dir: Path, window: Any, test: str) -> tuple[float, float]:
+    """``window`` as two floats, checked by the case schema's rule (:class:`deckgen.spec.Outputs`), for a cutting run;
+    else SpecError naming the run folder and the fix."""
+    from pydantic import ValidationError
+
+    from deckgen.spec import Outputs, SpecError
+
+    if test != "cutting":
+        raise SpecError(f"{run_dir}: a steady window is for cutting runs; this run is a {test} test (fix: drop it)")
     try:
         a, b = (float(x) for x in window)
-    except (TypeError, ValueError):
-        raise ValueError(f"{run_dir}: steady window {window!r} is not two numbers (fix: START END, e.g. 0.3 1.0)") from None
-    if not (0 <= a < b <= 1):
-        raise ValueError(f"{run_dir}: steady window {a:g} {b:g} is not two fractions 0 <= start < end <= 1 of the travel "
-                         "(fix: e.g. 0.3 1.0)")
-    if test is None:
-        spec_path = run_dir / "spec.json"
-        if not spec_path.is_file():
-            raise ValueError(f"{spec_path}: no spec.json (not a rendered run folder?)")
-        test = json.loads(spec_path.read_text())["case"].get("test")
-    if test != "cutting":
-        raise ValueError(f"{run_dir}: a steady window is for cutting runs; this run is a {test} test (fix: drop it)")
+        Outputs(steady_window=(a, b))
+    except (TypeError, ValueError) as exc:  # pydantic's ValidationError is a ValueError
+        why = exc.errors()[0]["msg"] if isinstance(exc, ValidationError) else "not two numbers"
+        raise SpecError(f"{run_dir}: steady window {' '.join(map(str, window))}: {why} (fix: START END fractions of "
+                        "the travel, e.g. 0.3 1.0)") from None
     return a, b
 
 
@@ -923,7 +922,7 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
     if test not in ("ucs", "bts", "cutting"):
         raise ValueError(f"{spec_path}: case.test is {test!r}, expected ucs, bts or cutting")
     if steady_window is not None:
-        a, b = check_steady_window(run_dir, steady_window, test)
+        a, b = _steady_window(run_dir, steady_window, test)
         spec = {**spec, "derived": {**spec["derived"], "steady_window": [a, b]}}
     derived = spec["derived"]
     engine = spec.get("engine") or case.get("engine", "lammps")
@@ -1010,8 +1009,6 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
                                f"peak_stress_Pa is a lower bound, not a strength (fix: raise specimen.max_strain)")
     else:
         extra = _cutting_summary(ts, spec)
-        window = derived.get("steady_window") or case["outputs"]["steady_window"]
-        extra["steady_window_start_1"], extra["steady_window_end_1"] = float(window[0]), float(window[1])
         extra["steady_window_source"] = "parse" if steady_window is not None else "case"
         note = extra.pop("notes_extra", None)
         if note:

@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 132 + 2 * len(NAMES)  # 132 case files + index.csv and README.md per family
+    assert len(files) == 136 + 2 * len(NAMES)  # 136 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -51,7 +51,7 @@ def test_case_counts_per_family():
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
-        ("rotary", "full"): 4, ("rotary", "reduced"): 8,  # 4 + 4 replicate packings
+        ("rotary", "full"): 4, ("rotary", "reduced"): 12,  # 4 + 2 x 4 replicate packings
         ("odc", "full"): 10, ("odc", "reduced"): 30,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 + 2 smooth long cuts
     }
 
@@ -219,11 +219,10 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
         assert c.cutter.diameter_mm == pytest.approx(431.8 / 8, abs=1e-3)
     assert sorted(set(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced"))) == [0.95, 1.9, 3.2, 3.8]
     assert sorted(set(c.kinematics.neighbour_spacing_mm for c in _cases("linear_ccs", "reduced"))) == [3.125, 6.375, 9.5, 12.5]
-    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25, 31.25, 62.5, 62.5, 125, 125,
-                                                                                         375, 375]
+    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25] * 3 + [62.5] * 3 + [125] * 3 + [375] * 3
     # the rotary window: the last 70 % of the travel (the middle window of linear_ccs holds one chip event on its block)
     assert {c.outputs.steady_window for c in _cases("rotary", "reduced")} == {(0.3, 1.0)}
-    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
+    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [303] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):

@@ -272,6 +272,40 @@ def test_tilted_disc_path_carries_its_axis_tilt_and_refuses_what_is_not_rendered
         cutter_path(case, R, axis=np.array([0.1, 0.99, 0.0]))
 
 
+def test_orbit_lift_ratio_places_the_orbit_between_start_and_bottom():
+    """kinematics.orbit_lift_ratio raises the centre path by ratio * e cos(tilt): 1 is penetration_at orbit_bottom, 0 the
+    start; it is refused outside oscillation, beside penetration_at orbit_bottom and outside [0, 1]."""
+    import numpy as np
+    from pydantic import ValidationError
+
+    from deckgen.deck import cutter_path
+    from deckgen.spec import Case, load_case
+
+    base = load_case(ROOT / "cases/odc/reduced/odc_red_s11.yaml")  # e 4 mm, clearance 9 deg
+    k = base.kinematics
+    assert "orbit_lift_ratio" not in base.model_dump(mode="json")["kinematics"]
+
+    def with_kin(**upd):
+        return base.model_copy(update={"kinematics": k.model_copy(update=upd)})
+
+    c9 = math.radians(9.0)
+    ax = np.array([0.0, math.cos(c9), -math.sin(c9)])
+    z = {r: cutter_path(with_kin(orbit_lift_ratio=r), 0.01, axis=ax)["zc0"] for r in (0.0, 0.56, 1.0)}
+    z_bottom = cutter_path(with_kin(penetration_at="orbit_bottom"), 0.01, axis=ax)["zc0"]
+    z_start = cutter_path(base, 0.01, axis=ax)["zc0"]
+    e = k.eccentricity_mm * 1e-3
+    assert z[0.0] == z_start and z[1.0] == pytest.approx(z_bottom, abs=1e-15)
+    assert z[0.56] - z_start == pytest.approx(0.56 * e * math.cos(c9), rel=1e-12)
+    assert with_kin(orbit_lift_ratio=0.56).model_dump(mode="json")["kinematics"]["orbit_lift_ratio"] == 0.56
+    data = base.model_dump()
+    for kin, msg in [({**data["kinematics"], "penetration_at": "orbit_bottom", "orbit_lift_ratio": 0.5}, "set one of them"),
+                     ({"mode": "linear", "speed_m_s": 2, "penetration_mm": 4, "travel_mm": 12, "orbit_lift_ratio": 0.5},
+                      "only mode oscillation has an orbit"),
+                     ({**data["kinematics"], "orbit_lift_ratio": 1.5}, "less than or equal to 1")]:
+        with pytest.raises(ValidationError, match=msg):
+            Case.model_validate({**data, "kinematics": kin})
+
+
 def test_penetration_at_orbit_bottom_lifts_the_orbit_by_e():
     """kinematics.penetration_at: orbit_bottom raises the centre path by e cos(tilt), so the deepest point of the
     orbit (not the start) is p deep; the default (start) leaves the path as before and out of resolved cases."""

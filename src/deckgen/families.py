@@ -466,7 +466,7 @@ SEED002_RADII = (250, 500, 1000, 3000)
 #: the block face at 59 % of the travel), alike at every radius. Chosen after looking at the session-22 runs
 #: (docs/families.md, "The rotary window"), and tested on the packing-seed-202 replicates run after it was fixed.
 ROTARY_REDUCED_WINDOW = (0.3, 1.0)
-ROTARY_REPLICATE_SEEDS = (202,)
+ROTARY_REPLICATE_SEEDS = (202, 303)
 
 
 def rotary() -> list[CaseDef]:
@@ -826,7 +826,7 @@ TABLE_FIELDS = [
 
 #: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them
 #: (a resolved case leaves some out at their defaults, which come from the spec).
-VARIANT_TOKENS = ("spin", "shaft_sense", "penetration_at")
+VARIANT_TOKENS = ("spin", "shaft_sense", "penetration_at", "orbit_lift_ratio")
 # (column, section of the case, field): the cutter's surface and friction of a variant beside its kinematics
 VARIANT_CUTTER = (("cutter_surface", "cutter", "surface"), ("cutter_friction_1", "contact", "cutter_friction"))
 

@@ -413,6 +413,12 @@ class Kinematics(_Model):
         "penetration_mm is measured. start: the disc's lowest point is p deep with the orbit's centre at its start "
         "height, so the disc reaches p + e at the bottom of the orbit; orbit_bottom: the centre path is raised by e "
         "(e cos of the axis tilt), so p is the deepest cut of the orbit. The default is left out of resolved cases.")
+    orbit_lift_ratio: float | None = Field(
+        None, ge=0, le=1, exclude_if=lambda v: v is None, json_schema_extra={"unit": "1"}, description="oscillation: "
+        "raise the centre path by this fraction of e (e cos of the axis tilt), so the deepest cut of the orbit is "
+        "p + (1 - ratio) e. 0 reads p as penetration_at start, 1 as orbit_bottom; values between are readings in "
+        "between (seed 003's kinematic removal rates, Table 5.2, fit 0.56: docs/families.md). Set this or "
+        "penetration_at, not both. Left out of resolved cases when unset.")
     neighbour_spacing_mm: float | None = _f(
         None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "
         "cut (relieved cutting between neighbours, seed 001); none = an isolated (unrelieved) groove.", gt=0,
@@ -504,6 +510,11 @@ class Case(_Model):
                 raise ValueError("kinematics.edge_distance_mm must be less than specimen.width_mm (it is measured from the y min face)")
             if k.penetration_at != "start" and k.mode != "oscillation":
                 raise ValueError("kinematics.penetration_at: only mode oscillation has an orbit (remove penetration_at)")
+            if k.orbit_lift_ratio is not None and k.mode != "oscillation":
+                raise ValueError("kinematics.orbit_lift_ratio: only mode oscillation has an orbit (remove orbit_lift_ratio)")
+            if k.orbit_lift_ratio is not None and k.penetration_at != "start":
+                raise ValueError("kinematics.orbit_lift_ratio and penetration_at both place the orbit: set one of them "
+                                 "(orbit_bottom is orbit_lift_ratio 1)")
             if k.shaft_sense != "forward" and k.mode != "oscillation":
                 raise ValueError("kinematics.shaft_sense: only mode oscillation has a shaft (remove shaft_sense)")
             if k.spin == "shaft" and k.mode != "oscillation":

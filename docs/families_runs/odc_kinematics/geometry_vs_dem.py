@@ -1,0 +1,129 @@
+"""The recorded 44 mm smooth-cone ODC cuts beside the swept-floor model of their paths (session 24).
+
+Reads the recorded tables of the smooth-cone runs (paths relative to this folder) and, for every oscillating run, the
+model's engaged arc and contact fraction (src/deckgen/odc_kinematics.py) at the run's e, nu and orbit reading. Each
+run's force is set over the straight cut of its own set (same cone, friction and speed). Writes
+geometry_vs_dem.csv here, and geometry_seed003_paths.csv: the model on seed 003's own paths beside its forces.
+
+    python docs/families_runs/odc_kinematics/geometry_vs_dem.py [--lift-runs DIR ...]
+
+``--lift-runs``: parsed folders of the orbit_lift_ratio diagnostics (their spec.json sits beside parsed/ or in the
+run folder); their rows join set A (the same cone, friction and speed as the family's smooth cuts).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import pandas as pd
+
+from deckgen.odc_kinematics import Orbit, sweep
+
+HERE = Path(__file__).resolve().parent
+RUNS = HERE.parent
+R_M, P_M = 0.010, 0.004
+SETS = {  # set: (table, force column, note)
+    "A": (RUNS / "odc_smooth/smoothcone_family/family_table.csv", "force_magnitude_N_mean_cycles_sliding",
+          "x4, upright smooth cone, friction 0.3, turning with the shaft (session 11)"),
+    "B": (RUNS / "odc_x1_smooth/x1_table.csv", "force_magnitude_N_mean_cycles_sliding",
+          "x1 (seed's speed), upright smooth cone, friction 0.3, turning (session 23)"),
+    "C": (RUNS / "odc_smooth/long_smooth_f0/family_table.csv", "force_magnitude_N_mean_cycles",
+          "x4, cone tilted 9 deg, smooth, friction 0 (session 10; first-cycle means)"),
+    "C_bottom": (RUNS / "odc_smooth/long_bottom_smooth_f0/family_table.csv", "force_magnitude_N_mean_cycles",
+                 "as C, depth at the orbit's bottom"),
+}
+LIFT = {"start": 0.0, "orbit_bottom": 1.0}
+
+
+def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
+    t = pd.read_csv(table)
+    name = t["variant_case"] if "variant_case" in t.columns else t["case"]
+    out = pd.DataFrame({"set": set_name, "run": name, "force_N": t[col], "dem_contact_fraction_1": t["contact_fraction_steady_1"]})
+    if set_name == "B":  # x1_table has the path as omega, speed and nu; the cases are the family's (bottom reading)
+        out["eccentricity_mm"] = [0.0 if not (n > 0) else v / (n * w) * 1e3 for n, v, w in
+                                  zip(t["velocity_ratio_nu_1"].fillna(0), t["cutter_speed_m_s"], t["omega_rad_s"])]
+        out["nu_1"] = t["velocity_ratio_nu_1"]
+        out["lift_1"] = 1.0
+    else:
+        out["eccentricity_mm"] = t["eccentricity_mm"].astype(float)
+        out["nu_1"] = t["velocity_ratio_nu_1"]
+        out["lift_1"] = t["penetration_at"].map(LIFT)
+    return out
+
+
+def _lift_rows(parsed: list[str]) -> pd.DataFrame:
+    rows = []
+    for d in map(Path, parsed):
+        s = json.loads((d / "summary.json").read_text())
+        spec = next(p for p in (d.parent / "spec.json", d.parent / "run" / "spec.json") if p.is_file())
+        k = json.loads(spec.read_text())["case"]["kinematics"]
+        rows.append({"set": "A", "run": s["case"], "force_N": s["force_magnitude_N_mean_cycles_sliding"],
+                     "dem_contact_fraction_1": s["contact_fraction_steady_1"], "eccentricity_mm": k["eccentricity_mm"],
+                     "nu_1": k["speed_m_s"] / (k["eccentricity_mm"] * 1e-3 * 2 * math.pi * k["frequency_hz"]),
+                     "lift_1": k.get("orbit_lift_ratio", LIFT[k.get("penetration_at", "start")])})
+    return pd.DataFrame(rows)
+
+
+def build(lift_runs: list[str] | None = None) -> pd.DataFrame:
+    parts = [_rows_of(s, *SETS[s][:2]) for s in SETS]
+    if lift_runs:
+        parts.append(_lift_rows(lift_runs))
+    t = pd.concat(parts, ignore_index=True)
+    straight = {s: float(g.loc[g["eccentricity_mm"] == 0, "force_N"].iloc[0]) for s, g in t.groupby("set")
+                if (g["eccentricity_mm"] == 0).any()}
+    straight_contact = {s: float(g.loc[g["eccentricity_mm"] == 0, "dem_contact_fraction_1"].iloc[0])
+                        for s, g in t.groupby("set") if (g["eccentricity_mm"] == 0).any()}
+    straight["C_bottom"], straight_contact["C_bottom"] = straight["C"], straight_contact["C"]
+    t = t[t["eccentricity_mm"] > 0].copy()
+    geo = []
+    for r in t.itertuples():
+        w = sweep(Orbit(R_M, P_M, r.eccentricity_mm * 1e-3, float(r.nu_1), float(r.lift_1)))
+        geo.append((w.arc_mean_m / w.arc_straight_m, w.contact_fraction, w.floor_mean_m / P_M))
+    t["geom_arc_ratio_1"], t["geom_contact_fraction_1"], t["geom_removal_ratio_1"] = zip(*geo)
+    t["deepest_cut_mm"] = P_M * 1e3 + (1 - t["lift_1"]) * t["eccentricity_mm"]
+    t["dem_force_ratio_1"] = t["force_N"] / t["set"].map(straight)
+    t["dem_contact_rel_1"] = t["dem_contact_fraction_1"] / t["set"].map(straight_contact)
+    t["dem_over_geom_1"] = t["dem_force_ratio_1"] / t["geom_arc_ratio_1"]
+    cols = ["set", "run", "eccentricity_mm", "nu_1", "lift_1", "deepest_cut_mm", "force_N", "dem_force_ratio_1",
+            "geom_arc_ratio_1", "dem_over_geom_1", "dem_contact_fraction_1", "dem_contact_rel_1",
+            "geom_contact_fraction_1", "geom_removal_ratio_1"]
+    return t[cols].round(4)
+
+
+#: seed 003's mean force over its straight cut (712 N, sec. 5.4.3; Table 5.1 and sec. 5.4.3 in ../shared/data)
+SEED003_RATIO = {(0.4, 22.5): 636 / 712, (0.4, 67.5): 442.3 / 712, (0.2, 22.5): 754 / 712, (0.1, 22.5): 735 / 712}
+
+
+def seed_series(lifts=(0.0, 0.57, 1.0)) -> pd.DataFrame:
+    """The model on seed 003's paths (R 10 mm, 4 mm, 0.5 m/s): its eccentricity series at 22.5 rev/s, its nu < 1
+    frequency series (e/R 0.4) and the nu > 1 frequency series it did not run (e/R 0.1), at three orbit readings."""
+    rows = []
+    paths = [(er, f) for er in (0.1, 0.2, 0.4) for f in (22.5,)] + [(er, f) for er in (0.4, 0.1) for f in (45.0, 60.0, 67.5)]
+    for er, f in paths:
+        for lift in lifts:
+            o = Orbit.from_rates(R_M, P_M, er * R_M, 0.5, f, lift)
+            w = sweep(o)
+            rows.append({"eccentricity_ratio_1": er, "rotation_rev_s": f, "nu_1": round(o.nu, 3), "lift_1": lift,
+                         "geom_arc_ratio_1": w.arc_mean_m / w.arc_straight_m, "geom_contact_fraction_1": w.contact_fraction,
+                         "geom_removal_ratio_1": w.floor_mean_m / P_M,
+                         "seed_force_ratio_1": SEED003_RATIO.get((er, f), float("nan"))})
+    return pd.DataFrame(rows).round(4)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--lift-runs", nargs="*", default=[])
+    a = ap.parse_args()
+    t = build(a.lift_runs)
+    t.to_csv(HERE / "geometry_vs_dem.csv", index=False)
+    seed = seed_series()
+    seed.to_csv(HERE / "geometry_seed003_paths.csv", index=False)
+    with pd.option_context("display.width", 250, "display.max_columns", 30):
+        print(t.to_string(index=False))
+        print(seed.to_string(index=False))
+
+
+if __name__ == "__main__":
+    main()

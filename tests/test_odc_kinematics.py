@@ -109,3 +109,19 @@ def test_recorded_comparison_with_the_smooth_cone_runs_holds():
     slow = t[t["nu_1"] < 1]
     assert (slow["dem_contact_fraction_1"] - slow["geom_contact_fraction_1"]).abs().max() < 0.07
     assert x4.loc[x4["deepest_cut_mm"] == 8.0, "dem_over_geom_1"].between(10, 21).all()
+
+
+def test_odc_family_reports_carry_each_runs_path_geometry(tmp_path):
+    """`families report/combine --family odc` writes geom_* columns: the model at each run's e, nu and orbit reading
+    (1 for straight cuts), the same as the finer comparison table within 0.01."""
+    out = tmp_path / "rep"
+    rec = ROOT / "docs/families_runs/odc_smooth/smoothcone_family/family_table.csv"
+    subprocess.run([sys.executable, "-m", "deckgen.families", "combine", "--family", "odc", "--index",
+                    str(ROOT / "cases/odc/index.csv"), "--out", str(out), str(rec)], check=True, capture_output=True)
+    t = pd.read_csv(out / "family_table.csv").set_index("case")
+    assert t.loc["odc_red_s10_long_smoothcone", ["geom_arc_ratio_1", "geom_contact_fraction_1"]].tolist() == [1.0, 1.0]
+    ref = pd.read_csv(ROOT / "docs/families_runs/odc_kinematics/geometry_vs_dem.csv")
+    ref = ref[ref["set"] == "A"].set_index("run")
+    for case in ("odc_red_s16_long_smoothcone", "odc_red_s103_long_smoothcone", "odc_red_s14_long_smoothcone"):
+        assert t.loc[case, "geom_arc_ratio_1"] == pytest.approx(ref.loc[case, "geom_arc_ratio_1"], abs=0.01)
+        assert t.loc[case, "geom_contact_fraction_1"] == pytest.approx(ref.loc[case, "geom_contact_fraction_1"], abs=0.01)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import functools
 import io
 import math
 import sys
@@ -1204,10 +1205,49 @@ def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None
     return _with_index_factors(idx, table)
 
 
+#: ODC cuts are 4 mm deep with a 10 mm disc at every scale (seed 003 sec. 5.2)
+ODC_DEPTH_MM = 4.0
+
+
+def with_path_geometry(table: "Any") -> "Any":
+    """An ODC family table with the swept-floor model of each run's path beside it (src/deckgen/odc_kinematics.py):
+    ``geom_arc_ratio_1`` (engaged arc over the straight cut's), ``geom_contact_fraction_1`` and ``geom_removal_ratio_1``
+    at the run's e, nu, orbit reading (penetration_at / orbit_lift_ratio) and shaft sense; 1 for straight cuts."""
+    def lift_of(row) -> float:
+        ratio = row.get("orbit_lift_ratio")
+        if ratio not in (None, "") and not (isinstance(ratio, float) and math.isnan(ratio)):
+            return float(ratio)
+        return 1.0 if row.get("penetration_at") == "orbit_bottom" else 0.0
+
+    cols = {"geom_arc_ratio_1": [], "geom_contact_fraction_1": [], "geom_removal_ratio_1": []}
+    for _, row in table.iterrows():
+        e_mm = float(row["eccentricity_mm"])
+        if e_mm <= 0:
+            vals = (1.0, 1.0, 1.0)
+        else:
+            sense = -1.0 if row.get("shaft_sense") == "backward" else 1.0
+            vals = _path_geometry(e_mm, float(row["velocity_ratio_nu_1"]), lift_of(row), sense)
+        for c, v in zip(cols, vals):
+            cols[c].append(v)
+    return table.assign(**cols)
+
+
+@functools.lru_cache(maxsize=256)
+def _path_geometry(e_mm: float, nu: float, lift: float, sense: float) -> tuple[float, float, float]:
+    from deckgen.odc_kinematics import Orbit, sweep
+
+    o = Orbit(ODC_R_MM * 1e-3, ODC_DEPTH_MM * 1e-3, e_mm * 1e-3, nu, lift, sense)
+    w = sweep(o, per_cycle=1000, dx_m=o.radius_m / 1000)
+    return (round(w.arc_mean_m / w.arc_straight_m, 4), round(w.contact_fraction, 4), round(w.floor_mean_m / o.depth_m, 4))
+
+
 def report_table(family: str, table: "Any", out: str | Path) -> Path:
-    """family_table.csv, plots, trends.csv (and regression.csv) of a family table into ``out``."""
+    """family_table.csv, plots, trends.csv (and regression.csv) of a family table into ``out``; ODC tables get the
+    path geometry of each run (:func:`with_path_geometry`)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    if family == "odc" and len(table) and "eccentricity_mm" in table.columns:
+        table = with_path_geometry(table)
     path = out / "family_table.csv"
     table.to_csv(path, index=False)
     family_plots(family, table, out / "plots")

@@ -3,7 +3,8 @@
 Reads the recorded tables of the smooth-cone runs (paths relative to this folder) and, for every oscillating run, the
 model's engaged arc and contact fraction (src/deckgen/odc_kinematics.py) at the run's e, nu and orbit reading. Each
 run's force is set over the straight cut of its own set (same cone, friction and speed). Writes
-geometry_vs_dem.csv here, and geometry_seed003_paths.csv: the model on seed 003's own paths beside its forces.
+geometry_vs_dem.csv here, and geometry_seed003_paths.csv: the model on seed 003's own paths beside its forces, and the plot
+geometry_vs_dem.png.
 
     python docs/families_runs/odc_kinematics/geometry_vs_dem.py [--lift-runs DIR ...]
 
@@ -112,12 +113,40 @@ def seed_series(lifts=(0.0, 0.57, 1.0)) -> pd.DataFrame:
     return pd.DataFrame(rows).round(4)
 
 
+def plot(t: pd.DataFrame, path: Path) -> None:
+    """Each run's force ratio against the engaged-arc ratio of its path (log-log, with the 1:1 line)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 4.5))
+    marks = {"A": "o", "B": "s", "C": "^", "C_bottom": "v"}
+    short = {"A": "x4 upright smooth, friction 0.3", "B": "x1 upright smooth, friction 0.3",
+             "C": "x4 tilted smooth, friction 0", "C_bottom": "as C, depth at orbit bottom"}
+    for name, g in t.groupby("set"):
+        ax.scatter(g["geom_arc_ratio_1"], g["dem_force_ratio_1"], marker=marks.get(name, "x"),
+                   label=f"{name}: {short.get(name, name)}")
+    lo, hi = 0.15, 20
+    ax.plot([lo, hi], [lo, hi], "k:", lw=1, label="force ratio = arc ratio")
+    ax.set(xscale="log", yscale="log", xlim=(0.15, 1.2), ylim=(lo, hi), xlabel="engaged arc / straight cut's (model)",
+           ylabel="mean force / straight cut's (bonded-particle runs)")
+    ax.legend(fontsize=7, loc="upper left")
+    for r in t[t["deepest_cut_mm"] > 5].itertuples():
+        ax.annotate(f"{r.deepest_cut_mm:g} mm deep", (r.geom_arc_ratio_1, r.dem_force_ratio_1), fontsize=6,
+                    xytext=(4, -8), textcoords="offset points")
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--lift-runs", nargs="*", default=[])
     a = ap.parse_args()
     t = build(a.lift_runs)
     t.to_csv(HERE / "geometry_vs_dem.csv", index=False)
+    plot(t, HERE / "geometry_vs_dem.png")
     seed = seed_series()
     seed.to_csv(HERE / "geometry_seed003_paths.csv", index=False)
     with pd.option_context("display.width", 250, "display.max_columns", 30):

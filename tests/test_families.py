@@ -757,6 +757,25 @@ def test_recorded_rotary_runs_over_the_wide_window_give_the_documented_trends(tm
     assert tr.loc["fs_falls_with_r", "p_value"] == pytest.approx(0.773, abs=1e-3)
 
 
+def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends(tmp_path):
+    """docs/families_runs/rotary_reduced_3packings: the 8 runs above plus packing seed 303 (session 24). Re-fitted from
+    the family table: the third packing's F_r/F_n rises +5 % from r 250 to r 1000 mm where the first two fell, so the
+    pooled fall is -7 % with p 0.41, and abs(F_s) stays unresolved (p 0.89); at r 500 mm the packings spread 0.34-0.61."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_reduced_3packings"
+    table = pd.read_csv(rec / "family_table.csv")
+    assert sorted(table["packing_seed"]) == [202] * 4 + [303] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
+    fr = table.pivot(index="rotary_radius_full_mm", columns="packing_seed", values="rolling_to_normal_ratio_1")
+    change = fr.loc[1000] / fr.loc[250] - 1
+    assert change[303] == pytest.approx(0.051, abs=1e-3) and (change[[202, fam.DEFAULT_PACKING_SEED]] < -0.2).all()
+    assert fr.loc[500].max() - fr.loc[500].min() == pytest.approx(0.275, abs=1e-3)
+    tr = _refit_recorded("rotary", rec, tmp_path)
+    assert tr.loc["fr_fn_falls_with_r", "change_1"] == pytest.approx(-0.075, abs=1e-3)
+    assert tr.loc["fr_fn_falls_with_r", "p_value"] == pytest.approx(0.406, abs=1e-3)
+    assert tr.loc["fs_falls_with_r", "p_value"] == pytest.approx(0.886, abs=1e-3)
+
+
 def test_recorded_x1_smooth_cone_cuts_give_the_documented_ratios():
     """docs/families_runs/odc_x1_smooth: the smooth upright cone at the seed's speed (session 23). The recorded summaries
     give the ratios docs/families.md reports: s103/s16 0.49 (as at x4), s16/s10 0.44 (x4: 0.87); x1_table.csv agrees

@@ -6,10 +6,10 @@ run's force is set over the straight cut of its own set (same cone, friction and
 geometry_vs_dem.csv here, and geometry_seed003_paths.csv: the model on seed 003's own paths beside its forces, and the plot
 geometry_vs_dem.png.
 
-    python docs/families_runs/odc_kinematics/geometry_vs_dem.py [--lift-runs DIR ...]
+    python docs/families_runs/odc_kinematics/geometry_vs_dem.py
 
-``--lift-runs``: parsed folders of the orbit_lift_ratio diagnostics (their spec.json sits beside parsed/ or in the
-run folder); their rows join set A (the same cone, friction and speed as the family's smooth cuts).
+The orbit_lift_ratio diagnostics of this folder (case file and recorded summary of each, session 24) join set A: the
+same cone, friction and speed as the family's smooth cuts.
 """
 from __future__ import annotations
 
@@ -54,23 +54,24 @@ def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
     return out
 
 
-def _lift_rows(parsed: list[str]) -> pd.DataFrame:
+def _lift_rows() -> pd.DataFrame:
+    """The orbit_lift_ratio diagnostics of this folder: each ``<case>_summary.json`` (the run's parsed summary) beside
+    its case file ``<case>.yaml``, whose kinematics give the path."""
+    from deckgen.spec import load_case
+
     rows = []
-    for d in map(Path, parsed):
-        s = json.loads((d / "summary.json").read_text())
-        spec = next(p for p in (d.parent / "spec.json", d.parent / "run" / "spec.json") if p.is_file())
-        k = json.loads(spec.read_text())["case"]["kinematics"]
+    for summ in sorted(HERE.glob("*_summary.json")):
+        s = json.loads(summ.read_text())
+        k = load_case(HERE / f"{s['case']}.yaml").kinematics
         rows.append({"set": "A", "run": s["case"], "force_N": s["force_magnitude_N_mean_cycles_sliding"],
-                     "dem_contact_fraction_1": s["contact_fraction_steady_1"], "eccentricity_mm": k["eccentricity_mm"],
-                     "nu_1": k["speed_m_s"] / (k["eccentricity_mm"] * 1e-3 * 2 * math.pi * k["frequency_hz"]),
-                     "lift_1": k.get("orbit_lift_ratio", LIFT[k.get("penetration_at", "start")])})
+                     "dem_contact_fraction_1": s["contact_fraction_steady_1"], "eccentricity_mm": k.eccentricity_mm,
+                     "nu_1": round(k.speed_m_s / (k.eccentricity_mm * 1e-3 * 2 * math.pi * k.frequency_hz), 3),
+                     "lift_1": k.orbit_lift_ratio if k.orbit_lift_ratio is not None else LIFT[k.penetration_at]})
     return pd.DataFrame(rows)
 
 
-def build(lift_runs: list[str] | None = None) -> pd.DataFrame:
-    parts = [_rows_of(s, *SETS[s][:2]) for s in SETS]
-    if lift_runs:
-        parts.append(_lift_rows(lift_runs))
+def build() -> pd.DataFrame:
+    parts = [_rows_of(s, *SETS[s][:2]) for s in SETS] + [_lift_rows()]
     t = pd.concat(parts, ignore_index=True)
     straight = {s: float(g.loc[g["eccentricity_mm"] == 0, "force_N"].iloc[0]) for s, g in t.groupby("set")
                 if (g["eccentricity_mm"] == 0).any()}
@@ -141,10 +142,8 @@ def plot(t: pd.DataFrame, path: Path) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--lift-runs", nargs="*", default=[])
-    a = ap.parse_args()
-    t = build(a.lift_runs)
+    argparse.ArgumentParser(description=__doc__.split("\n")[0]).parse_args()
+    t = build()
     t.to_csv(HERE / "geometry_vs_dem.csv", index=False)
     plot(t, HERE / "geometry_vs_dem.png")
     seed = seed_series()

@@ -417,7 +417,7 @@ class Kinematics(_Model):
         None, ge=0, le=1, exclude_if=lambda v: v is None, json_schema_extra={"unit": "1"}, description="oscillation: "
         "raise the centre path by this fraction of e (e cos of the axis tilt), so the deepest cut of the orbit is "
         "p + (1 - ratio) e. 0 reads p as penetration_at start, 1 as orbit_bottom; values between are readings in "
-        "between (seed 003's kinematic removal rates, Table 5.2, fit 0.56: docs/families.md). Set this or "
+        "between (seed 003's kinematic removal rates, Table 5.2, fit 0.56-0.59: docs/families.md). Set this or "
         "penetration_at, not both. Left out of resolved cases when unset.")
     neighbour_spacing_mm: float | None = _f(
         None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "

@@ -364,9 +364,8 @@ def cutter_path(case: Case, R: float, axis: np.ndarray | None = None) -> dict[st
                 raise SpecError(f"case {case.name}: a tilted disc (cutter.tilt_deg or a cone's clearance angle) that "
                                 f"spins in {k.mode} is not rendered (fix: tilt 0, or kinematics.spin none)")
             out["axis_tilt"] = alpha
-    lift_ratio = 1.0 if k.penetration_at == "orbit_bottom" else (k.orbit_lift_ratio or 0.0)
-    if lift_ratio > 0 and e > 0:  # orbit_bottom: p is the deepest cut of the orbit, not the start depth
-        lift = lift_ratio * e * math.cos(out.get("axis_tilt", 0.0))
+    if k.orbit_lift > 0 and e > 0:  # orbit_bottom: p is the deepest cut of the orbit, not the start depth
+        lift = k.orbit_lift * e * math.cos(out.get("axis_tilt", 0.0))
         out["zc0"] = zc0 + lift
         out["orbit_lift"] = lift
     if k.mode == "rotary":

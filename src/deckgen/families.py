@@ -1213,11 +1213,12 @@ def with_path_geometry(table: "Any") -> "Any":
     """An ODC family table with the swept-floor model of each run's path beside it (src/deckgen/odc_kinematics.py):
     ``geom_arc_ratio_1`` (engaged arc over the straight cut's), ``geom_contact_fraction_1`` and ``geom_removal_ratio_1``
     at the run's e, nu, orbit reading (penetration_at / orbit_lift_ratio) and shaft sense; 1 for straight cuts."""
-    def lift_of(row) -> float:
+    from deckgen.spec import orbit_lift
+
+    def lift_of(row) -> float:  # a table leaves an unset ratio empty or NaN
         ratio = row.get("orbit_lift_ratio")
-        if ratio not in (None, "") and not (isinstance(ratio, float) and math.isnan(ratio)):
-            return float(ratio)
-        return 1.0 if row.get("penetration_at") == "orbit_bottom" else 0.0
+        unset = ratio in (None, "") or (isinstance(ratio, float) and math.isnan(ratio))
+        return orbit_lift(row.get("penetration_at", "start"), None if unset else float(ratio))
 
     cols = {"geom_arc_ratio_1": [], "geom_contact_fraction_1": [], "geom_removal_ratio_1": []}
     for _, row in table.iterrows():
@@ -1238,7 +1239,7 @@ def _path_geometry(e_mm: float, nu: float, lift: float, sense: float) -> tuple[f
 
     o = Orbit(ODC_R_MM * 1e-3, ODC_DEPTH_MM * 1e-3, e_mm * 1e-3, nu, lift, sense)
     w = sweep(o, per_cycle=1000, dx_m=o.radius_m / 1000)
-    return (round(w.arc_mean_m / w.arc_straight_m, 4), round(w.contact_fraction, 4), round(w.floor_mean_m / o.depth_m, 4))
+    return (round(w.arc_ratio, 4), round(w.contact_fraction, 4), round(w.removal_ratio, 4))
 
 
 def report_table(family: str, table: "Any", out: str | Path) -> Path:

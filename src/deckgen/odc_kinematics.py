@@ -20,7 +20,7 @@ removal rates ("calculated from kinematics and assumes rock only fails at the po
   removed (its columns lie deeper than the floor swept so far). Its length, over the straight cut's R acos(1 - p/R),
   is a contact measure of the kind seed 003 sec. 5.4.3 names as the cause of the force drop ("the contact area during
   an oscillation cycle becomes smaller if backward motion occurs"); the fraction of the time it is non-zero is the
-  geometric contact fraction (:func:`engagement`).
+  geometric contact fraction (:func:`sweep`).
 
 Chips, crushing ahead of the disc and the rate of loading are outside this model; docs/families.md (section "The ODC
 path as geometry") sets it beside the bonded-particle runs. Written here because no library computes a swept
@@ -93,6 +93,17 @@ class Sweep:
     arc_mean_m: float  # mean engaged arc length
     contact_fraction: float  # fraction of the time with an engaged arc above the threshold
     arc_straight_m: float  # R acos(1 - p/R): the straight cut's engaged arc
+    depth_m: float  # the straight cut's depth p
+
+    @property
+    def arc_ratio(self) -> float:
+        """Mean engaged arc over the straight cut's."""
+        return self.arc_mean_m / self.arc_straight_m
+
+    @property
+    def removal_ratio(self) -> float:
+        """Removed area per unit travel over the straight cut's (seed 003 Table 5.2's rock removal rate)."""
+        return self.floor_mean_m / self.depth_m
 
 
 def straight_arc(radius_m: float, depth_m: float) -> float:
@@ -107,13 +118,12 @@ def sweep(orbit: Orbit, turns: int = 3, per_cycle: int = 2000, dx_m: float | Non
     contact. A straight cut (e = 0) averages over 2R of travel after the same lead-in."""
     R, e = orbit.radius_m, orbit.ecc_m
     dx = dx_m or R / 2000
-    lead = 2 * R + 2 * e
     if e == 0:
-        theta = np.linspace(0.0, 4.0 + 2.0, 6 * per_cycle // 2 + 1)  # theta = travel / R
-        t0, t1 = 2.0 + 2 * e / R, 4.0 + 2 * e / R
+        theta = np.linspace(0.0, 6.0, 3 * per_cycle + 1)  # theta = travel / R
+        t0, t1 = 2.0, 4.0
     else:
         lam = orbit.travel_per_cycle_m
-        n0 = math.ceil(lead / lam)  # whole turns before the steady ones
+        n0 = math.ceil((2 * R + 2 * e) / lam)  # whole turns before the steady ones
         n = n0 + turns + math.ceil((R + 2 * e) / lam)  # the disc must also pass beyond the last steady columns
         theta = np.linspace(0.0, 2 * math.pi * n, n * per_cycle + 1)
         t0, t1 = 2 * math.pi * n0, 2 * math.pi * (n0 + turns)
@@ -137,12 +147,12 @@ def sweep(orbit: Orbit, turns: int = 3, per_cycle: int = 2000, dx_m: float | Non
     x_hi = float(orbit.centre(np.array([t1]))[0][0])
     cols = (x >= x_lo) & (x < x_hi)
     return Sweep(float(floor[cols].mean()), float(arc[steady].mean()),
-                 float((arc[steady] > contact_threshold * a0).mean()), a0)
+                 float((arc[steady] > contact_threshold * a0).mean()), a0, orbit.depth_m)
 
 
 def removal_ratio(orbit: Orbit, **kw) -> float:
     """Removed area per unit travel, oscillating over straight (seed 003 Table 5.2's rock removal rate)."""
-    return sweep(orbit, **kw).floor_mean_m / orbit.depth_m
+    return sweep(orbit, **kw).removal_ratio
 
 
 def fit_lift(ecc_ratio: float, rev_s: float, speed_m_s: float, target: float, radius_m: float = SEED003_R_M,
@@ -199,8 +209,8 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
-    print(f"nu {o.nu:.3f}  removal ratio {s.floor_mean_m / o.depth_m:.3f}  engaged arc / straight "
-          f"{s.arc_mean_m / s.arc_straight_m:.3f}  contact fraction {s.contact_fraction:.3f}")
+    print(f"nu {o.nu:.3f}  removal ratio {s.removal_ratio:.3f}  engaged arc / straight {s.arc_ratio:.3f}  "
+          f"contact fraction {s.contact_fraction:.3f}")
     return 0
 
 

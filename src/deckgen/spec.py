@@ -378,6 +378,13 @@ class Cutter(_Model):
         "resolved cases.")
 
 
+def orbit_lift(penetration_at: str, orbit_lift_ratio: float | None) -> float:
+    """The orbit's lift as a fraction of e: ``orbit_lift_ratio`` when set, 1 for ``penetration_at: orbit_bottom``, else 0."""
+    if orbit_lift_ratio is not None:
+        return float(orbit_lift_ratio)
+    return 1.0 if penetration_at == "orbit_bottom" else 0.0
+
+
 class Kinematics(_Model):
     """Cutter motion. x = forward (cut) direction, z = up, disc axis = y.
 
@@ -423,6 +430,11 @@ class Kinematics(_Model):
         None, "mm", "linear/rotary: grooves of the same disc at +-S beside the cut are removed from the block before the "
         "cut (relieved cutting between neighbours, seed 001); none = an isolated (unrelieved) groove.", gt=0,
     )
+
+    @property
+    def orbit_lift(self) -> float:
+        """The orbit's lift as a fraction of e (:func:`orbit_lift`)."""
+        return orbit_lift(self.penetration_at, self.orbit_lift_ratio)
 
 
 # --------------------------------------------------------------------------- run / outputs

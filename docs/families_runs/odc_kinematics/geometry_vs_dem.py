@@ -21,6 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from deckgen.odc_kinematics import Orbit, sweep
+from deckgen.spec import orbit_lift
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE.parent
@@ -35,7 +36,6 @@ SETS = {  # set: (table, force column, note)
     "C_bottom": (RUNS / "odc_smooth/long_bottom_smooth_f0/family_table.csv", "force_magnitude_N_mean_cycles",
                  "as C, depth at the orbit's bottom"),
 }
-LIFT = {"start": 0.0, "orbit_bottom": 1.0}
 
 
 def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
@@ -50,7 +50,7 @@ def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
     else:
         out["eccentricity_mm"] = t["eccentricity_mm"].astype(float)
         out["nu_1"] = t["velocity_ratio_nu_1"]
-        out["lift_1"] = t["penetration_at"].map(LIFT)
+        out["lift_1"] = [orbit_lift(p, None) for p in t["penetration_at"]]
     return out
 
 
@@ -66,7 +66,7 @@ def _lift_rows() -> pd.DataFrame:
         rows.append({"set": "A", "run": s["case"], "force_N": s["force_magnitude_N_mean_cycles_sliding"],
                      "dem_contact_fraction_1": s["contact_fraction_steady_1"], "eccentricity_mm": k.eccentricity_mm,
                      "nu_1": round(k.speed_m_s / (k.eccentricity_mm * 1e-3 * 2 * math.pi * k.frequency_hz), 3),
-                     "lift_1": k.orbit_lift_ratio if k.orbit_lift_ratio is not None else LIFT[k.penetration_at]})
+                     "lift_1": k.orbit_lift})
     return pd.DataFrame(rows)
 
 
@@ -82,7 +82,7 @@ def build() -> pd.DataFrame:
     geo = []
     for r in t.itertuples():
         w = sweep(Orbit(R_M, P_M, r.eccentricity_mm * 1e-3, float(r.nu_1), float(r.lift_1)))
-        geo.append((w.arc_mean_m / w.arc_straight_m, w.contact_fraction, w.floor_mean_m / P_M))
+        geo.append((w.arc_ratio, w.contact_fraction, w.removal_ratio))
     t["geom_arc_ratio_1"], t["geom_contact_fraction_1"], t["geom_removal_ratio_1"] = zip(*geo)
     t["deepest_cut_mm"] = P_M * 1e3 + (1 - t["lift_1"]) * t["eccentricity_mm"]
     t["dem_force_ratio_1"] = t["force_N"] / t["set"].map(straight)
@@ -108,8 +108,8 @@ def seed_series(lifts=(0.0, 0.57, 1.0)) -> pd.DataFrame:
             o = Orbit.from_rates(R_M, P_M, er * R_M, 0.5, f, lift)
             w = sweep(o)
             rows.append({"eccentricity_ratio_1": er, "rotation_rev_s": f, "nu_1": round(o.nu, 3), "lift_1": lift,
-                         "geom_arc_ratio_1": w.arc_mean_m / w.arc_straight_m, "geom_contact_fraction_1": w.contact_fraction,
-                         "geom_removal_ratio_1": w.floor_mean_m / P_M,
+                         "geom_arc_ratio_1": w.arc_ratio, "geom_contact_fraction_1": w.contact_fraction,
+                         "geom_removal_ratio_1": w.removal_ratio,
                          "seed_force_ratio_1": SEED003_RATIO.get((er, f), float("nan"))})
     return pd.DataFrame(rows).round(4)
 

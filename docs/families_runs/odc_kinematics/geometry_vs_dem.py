@@ -73,11 +73,9 @@ def _lift_rows() -> pd.DataFrame:
 def build() -> pd.DataFrame:
     parts = [_rows_of(s, *SETS[s][:2]) for s in SETS] + [_lift_rows()]
     t = pd.concat(parts, ignore_index=True)
-    straight = {s: float(g.loc[g["eccentricity_mm"] == 0, "force_N"].iloc[0]) for s, g in t.groupby("set")
-                if (g["eccentricity_mm"] == 0).any()}
-    straight_contact = {s: float(g.loc[g["eccentricity_mm"] == 0, "dem_contact_fraction_1"].iloc[0])
-                        for s, g in t.groupby("set") if (g["eccentricity_mm"] == 0).any()}
-    straight["C_bottom"], straight_contact["C_bottom"] = straight["C"], straight_contact["C"]
+    # each set's straight cut (C_bottom shares C's)
+    straight = t[t["eccentricity_mm"] == 0].groupby("set")[["force_N", "dem_contact_fraction_1"]].first()
+    straight.loc["C_bottom"] = straight.loc["C"]
     t = t[t["eccentricity_mm"] > 0].copy()
     geo = []
     for r in t.itertuples():
@@ -85,8 +83,8 @@ def build() -> pd.DataFrame:
         geo.append((w.arc_ratio, w.contact_fraction, w.removal_ratio))
     t["geom_arc_ratio_1"], t["geom_contact_fraction_1"], t["geom_removal_ratio_1"] = zip(*geo)
     t["deepest_cut_mm"] = P_M * 1e3 + (1 - t["lift_1"]) * t["eccentricity_mm"]
-    t["dem_force_ratio_1"] = t["force_N"] / t["set"].map(straight)
-    t["dem_contact_rel_1"] = t["dem_contact_fraction_1"] / t["set"].map(straight_contact)
+    t["dem_force_ratio_1"] = t["force_N"] / t["set"].map(straight["force_N"])
+    t["dem_contact_rel_1"] = t["dem_contact_fraction_1"] / t["set"].map(straight["dem_contact_fraction_1"])
     t["dem_over_geom_1"] = t["dem_force_ratio_1"] / t["geom_arc_ratio_1"]
     cols = ["set", "run", "eccentricity_mm", "nu_1", "lift_1", "deepest_cut_mm", "force_N", "dem_force_ratio_1",
             "geom_arc_ratio_1", "dem_over_geom_1", "dem_contact_fraction_1", "dem_contact_rel_1",

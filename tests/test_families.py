@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 136 + 2 * len(NAMES)  # 136 case files + index.csv and README.md per family
+    assert len(files) == 145 + 2 * len(NAMES)  # 145 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -51,8 +51,8 @@ def test_case_counts_per_family():
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
         ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
-        ("rotary", "full"): 4, ("rotary", "reduced"): 12,  # 4 + 2 x 4 replicate packings
-        ("odc", "full"): 10, ("odc", "reduced"): 30,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 + 2 smooth long cuts
+        ("rotary", "full"): 4, ("rotary", "reduced"): 20,  # 4 + 4 x 4 replicate packings
+        ("odc", "full"): 10, ("odc", "reduced"): 31,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 + 3 smooth long cuts
     }
 
 
@@ -219,10 +219,10 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
         assert c.cutter.diameter_mm == pytest.approx(431.8 / 8, abs=1e-3)
     assert sorted(set(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced"))) == [0.95, 1.9, 3.2, 3.8]
     assert sorted(set(c.kinematics.neighbour_spacing_mm for c in _cases("linear_ccs", "reduced"))) == [3.125, 6.375, 9.5, 12.5]
-    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25] * 3 + [62.5] * 3 + [125] * 3 + [375] * 3
+    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25] * 5 + [62.5] * 5 + [125] * 5 + [375] * 5
     # the rotary window: the last 70 % of the travel (the middle window of linear_ccs holds one chip event on its block)
     assert {c.outputs.steady_window for c in _cases("rotary", "reduced")} == {(0.3, 1.0)}
-    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [303] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
+    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [303] * 4 + [404] * 4 + [505] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):
@@ -511,7 +511,7 @@ def test_snakemake_plans_the_trend_subsets(tmp_path):
     assert res.returncode == 0, res.stderr[-2000:]
     text = " ".join((res.stdout + res.stderr).split())
     n = sum(len(v) for v in fam.TREND_SUBSETS.values())
-    assert n == 20
+    assert n == 21
     for rule, count in [("pack", n), ("run", n), ("family_report", len(NAMES))]:
         assert f"{rule} {count}" in text, (rule, count, text[-1500:])
     for names in fam.TREND_SUBSETS.values():
@@ -774,6 +774,42 @@ def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends
     assert tr.loc["fr_fn_falls_with_r", "change_1"] == pytest.approx(-0.075, abs=1e-3)
     assert tr.loc["fr_fn_falls_with_r", "p_value"] == pytest.approx(0.406, abs=1e-3)
     assert tr.loc["fs_falls_with_r", "p_value"] == pytest.approx(0.886, abs=1e-3)
+    # unresolved, but not uninformative: the 95 % interval of the F_r/F_n change excludes the seed's -47 % (session 25)
+    ci = tr.loc["fr_fn_falls_with_r", ["change_1_ci95_low", "change_1_ci95_high"]].astype(float)
+    assert ci.to_numpy() == pytest.approx([-0.230, 0.139], abs=1e-3)
+    assert not tr.loc["fr_fn_falls_with_r", "seed_change_in_ci95"]
+
+
+def test_trend_confidence_interval_of_the_change_and_whether_it_holds_the_seed_size():
+    """trend_table's change_1_ci95_low/high: the change along the line at the ends of the slope's 95 % interval,
+    checked against numpy's least squares and scipy's t quantile; seed_change_in_ci95 says whether the seed's change
+    (rotary F_r/F_n: -47 % from r 250 to 1000 mm) lies inside."""
+    import pandas as pd
+    from scipy import stats
+
+    r = np.array([250, 500, 1000, 3000] * 3, dtype=float)
+    x = np.log(r)
+
+    def fit(y):
+        t = fam.trend_table("rotary", pd.DataFrame({"case": [f"c{i}" for i in range(len(r))], "rotary_radius_full_mm": r,
+                                                    "rolling_to_normal_ratio_1": y, "force_side_N_mean_steady": y}))
+        return t.set_index("trend").loc["fr_fn_falls_with_r"]
+
+    exact = 0.4 - 0.1 * np.log(r / 250)  # -0.1 ln 4 / 0.4 = -34.7 % from 250 to 1000 mm
+    row = fit(exact + 1e-9 * np.sin(np.arange(len(r))))
+    assert row["change_1"] == pytest.approx(-0.1 * np.log(4) / 0.4, abs=1e-6)
+    assert row["change_1_ci95_low"] == pytest.approx(row["change_1"], abs=1e-6)
+    assert row["change_1_ci95_high"] == pytest.approx(row["change_1"], abs=1e-6)
+    assert not row["seed_change_in_ci95"]  # a sharp -35 % excludes the seed's -47 %
+    noisy = exact + 0.08 * np.array([1, -1, 1, -1, -1, 1, -1, 1, 1, 1, -1, -1])
+    row = fit(noisy)
+    b, a = np.polyfit(x, noisy, 1)
+    se = np.sqrt(((noisy - (a + b * x)) ** 2).sum() / (len(x) - 2) / ((x - x.mean()) ** 2).sum())
+    q = stats.t.ppf(0.975, len(x) - 2)
+    want = sorted(s * np.log(4) / (noisy.mean() + s * (np.log(250) - x.mean())) for s in (b - q * se, b + q * se))
+    assert [row["change_1_ci95_low"], row["change_1_ci95_high"]] == pytest.approx(want, abs=1e-9)
+    assert row["change_1_ci95_low"] < row["change_1"] < row["change_1_ci95_high"]
+    assert want[0] <= -0.4702503501894313 <= want[1] and row["seed_change_in_ci95"]  # scatter that cannot tell -40 % from -47 %
 
 
 def test_recorded_x1_smooth_cone_cuts_give_the_documented_ratios():

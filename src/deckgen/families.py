@@ -467,7 +467,7 @@ SEED002_RADII = (250, 500, 1000, 3000)
 #: the block face at 59 % of the travel), alike at every radius. Chosen after looking at the session-22 runs
 #: (docs/families.md, "The rotary window"), and tested on the packing-seed-202 replicates run after it was fixed.
 ROTARY_REDUCED_WINDOW = (0.3, 1.0)
-ROTARY_REPLICATE_SEEDS = (202, 303)
+ROTARY_REPLICATE_SEEDS = (202, 303, 404, 505)
 
 
 def rotary() -> list[CaseDef]:
@@ -577,8 +577,9 @@ ODC_X1_SIMS = (12, 13, 14, 101, 102, 103)
 #: have no long shell cut; their 44 mm cuts are here only.
 ODC_SMOOTH_SIMS = (10, 11, 14, 16, 101, 103)
 #: replicate packings of the smooth long cuts of the nu < 1 pair (``_k<seed>``): a 44 mm cut holds one cycle at 90 Hz
-#: and chipping moves a one-cycle mean by +-20 %, so the nu < 1 fall (seed -30 %) needs a second packing
-ODC_SMOOTH_REPLICATE_SIMS = (11, 14)
+#: and chipping moves a one-cycle mean by +-20 %, so the nu < 1 fall (seed -30 %) needs a second packing. The straight
+#: cut (sim 10) on the same packing gives that packing's own reference for force ratios (session 25).
+ODC_SMOOTH_REPLICATE_SIMS = (10, 11, 14)
 ODC_SMOOTH_REPLICATE_SEEDS = (202,)
 SEED003_CLEARANCE_DEG = 9
 
@@ -1061,8 +1062,10 @@ def trend_table(family: str, table: "Any") -> "Any":
 
     Columns: runs and groups used, pooled slope and its p-value (when there are more runs than
     parameters), the relative change of y along the pooled line over the seed's x range (mean over
-    groups; ``extrapolated`` when the runs do not span that range), the seed's, and whether the sign
-    is the seed's."""
+    groups; ``extrapolated`` when the runs do not span that range), the same change at the ends of the slope's
+    95 % confidence interval (``change_1_ci95_low``/``_high``) and whether the seed's change lies inside it
+    (``seed_change_in_ci95``: False means the runs exclude the seed's size, not only fail to resolve a trend),
+    the seed's change, and whether the sign is the seed's."""
     import numpy as np
     import pandas as pd
     import statsmodels.formula.api as smf
@@ -1100,26 +1103,36 @@ def trend_table(family: str, table: "Any") -> "Any":
         dy = t["_y"] - t.groupby("_g")["_y"].transform("mean")
         slope = float((dx * dy).sum() / (dx * dx).sum())
         dof = len(t) - (1 + t["_g"].nunique())
-        pval = float("nan")
+        pval, ci = float("nan"), (float("nan"), float("nan"))
         if dof >= 1:
             formula = "_y ~ _x" + (" + C(_g)" if t["_g"].nunique() > 1 else "")
             fit = smf.ols(formula, data=t).fit()
             slope, pval = float(fit.params["_x"]), float(fit.pvalues["_x"])
+            ci = tuple(float(v) for v in fit.conf_int(alpha=0.05).loc["_x"])
         # relative change of each group's line over the seed's x range, averaged over the groups
         x0, x1 = (np.log(v) for v in tr.x_range) if tr.log_x else tr.x_range
-        changes = []
-        for _, g in t.groupby("_g"):
-            y0 = g["_y"].mean() + slope * (x0 - g["_x"].mean())
-            changes.append(slope * (x1 - x0) / abs(y0) if y0 != 0 else float("nan"))
+
+        def change_at(b: float) -> float:
+            out = []
+            for _, g in t.groupby("_g"):
+                y0 = g["_y"].mean() + b * (x0 - g["_x"].mean())
+                out.append(b * (x1 - x0) / abs(y0) if y0 != 0 else float("nan"))
+            return float(np.nanmean(out))
+
+        ci_change = sorted(change_at(b) for b in ci) if ci[0] == ci[0] else [float("nan"), float("nan")]
+        seed_in = (bool(ci_change[0] <= tr.seed_change <= ci_change[1])
+                   if ci_change[0] == ci_change[0] and tr.seed_change == tr.seed_change else None)
         xs = t[tr.x]
         extrapolated = bool(xs.min() > min(tr.x_range) * 1.001 or xs.max() < max(tr.x_range) * 0.999)
-        rows.append({**row, "slope": slope, "p_value": pval, "change_1": float(np.nanmean(changes)),
+        rows.append({**row, "slope": slope, "p_value": pval, "change_1": change_at(slope),
+                     "change_1_ci95_low": ci_change[0], "change_1_ci95_high": ci_change[1], "seed_change_in_ci95": seed_in,
                      "runs_x_min": float(xs.min()), "runs_x_max": float(xs.max()), "extrapolated": extrapolated,
                      "sign_as_seed": (bool(np.sign(slope) == tr.expect) if tr.expect else
                                       (bool(pval >= 0.05) if pval == pval else None)),
                      "significant_5pct": (bool(pval < 0.05) if pval == pval else None)})
     cols = ["family", "trend", "description", "y", "x", "x_range_seed", "runs", "groups", "slope", "p_value", "change_1",
-            "seed_change_1", "runs_x_min", "runs_x_max", "extrapolated", "sign_as_seed", "significant_5pct", "expected_sign",
+            "change_1_ci95_low", "change_1_ci95_high", "seed_change_in_ci95", "seed_change_1", "runs_x_min", "runs_x_max",
+            "extrapolated", "sign_as_seed", "significant_5pct", "expected_sign",
             "seed_source"]
     return pd.DataFrame(rows, columns=cols)
 

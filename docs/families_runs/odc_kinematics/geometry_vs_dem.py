@@ -2,20 +2,23 @@
 
 Reads the recorded tables of the smooth-cone runs (paths relative to this folder) and, for every oscillating run, the
 model's engaged arc and contact fraction (src/deckgen/odc_kinematics.py) at the run's e, nu and orbit reading. Each
-run's force is set over the straight cut of its own set (same cone, friction and speed). Writes
+run's force is set over the straight cut of its own set (same cone, friction and speed) on its own packing where that
+straight cut was run (``_k<seed>`` in the name; column straight_packing says which packing's cut was used). Writes
 geometry_vs_dem.csv here, and geometry_seed003_paths.csv: the model on seed 003's own paths beside its forces, and the plot
 geometry_vs_dem.png.
 
     python docs/families_runs/odc_kinematics/geometry_vs_dem.py
 
-The orbit_lift_ratio diagnostics of this folder (case file and recorded summary of each, session 24) join set A: the
-same cone, friction and speed as the family's smooth cuts.
+The diagnostics of this folder (a recorded summary of each, beside its case file here or in cases/odc/reduced; the
+orbit_lift_ratio cuts of session 24, the packing-202 cuts of sessions 24-25) join set A: the same cone, friction and
+speed as the family's smooth cuts.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -25,6 +28,8 @@ from deckgen.spec import orbit_lift
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE.parent
+FAMILY_CASES = HERE.parents[2] / "cases" / "odc" / "reduced"
+DEFAULT_PACKING = 12345  # deckgen.families.DEFAULT_PACKING_SEED: cases without a _k<seed> suffix
 R_M, P_M = 0.010, 0.004
 SETS = {  # set: (table, force column, note)
     "A": (RUNS / "odc_smooth/smoothcone_family/family_table.csv", "force_magnitude_N_mean_cycles_sliding",
@@ -55,38 +60,51 @@ def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
 
 
 def _lift_rows() -> pd.DataFrame:
-    """The orbit_lift_ratio diagnostics of this folder: each ``<case>_summary.json`` (the run's parsed summary) beside
-    its case file ``<case>.yaml``, whose kinematics give the path."""
+    """The diagnostics of this folder: each ``<case>_summary.json`` (the run's parsed summary) beside its case file
+    ``<case>.yaml`` (here, or the family's in cases/odc/reduced), whose kinematics give the path."""
     from deckgen.spec import load_case
 
     rows = []
     for summ in sorted(HERE.glob("*_summary.json")):
         s = json.loads(summ.read_text())
-        k = load_case(HERE / f"{s['case']}.yaml").kinematics
+        case = HERE / f"{s['case']}.yaml"
+        k = load_case(case if case.is_file() else FAMILY_CASES / case.name).kinematics
+        osc = k.mode == "oscillation"
         rows.append({"set": "A", "run": s["case"], "force_N": s["force_magnitude_N_mean_cycles_sliding"],
-                     "dem_contact_fraction_1": s["contact_fraction_steady_1"], "eccentricity_mm": k.eccentricity_mm,
-                     "nu_1": round(k.speed_m_s / (k.eccentricity_mm * 1e-3 * 2 * math.pi * k.frequency_hz), 3),
-                     "lift_1": k.orbit_lift})
+                     "dem_contact_fraction_1": s["contact_fraction_steady_1"],
+                     "eccentricity_mm": k.eccentricity_mm if osc else 0.0,
+                     "nu_1": round(k.speed_m_s / (k.eccentricity_mm * 1e-3 * 2 * math.pi * k.frequency_hz), 3)
+                     if osc else float("inf"), "lift_1": k.orbit_lift if osc else 1.0})
     return pd.DataFrame(rows)
+
+
+def packing_of(run: str) -> int:
+    """The packing seed of a run from its name (``..._k202...``), else the family's default."""
+    m = re.search(r"_k(\d+)(?:_|$)", run)
+    return int(m.group(1)) if m else DEFAULT_PACKING
 
 
 def build() -> pd.DataFrame:
     parts = [_rows_of(s, *SETS[s][:2]) for s in SETS] + [_lift_rows()]
     t = pd.concat(parts, ignore_index=True)
-    # each set's straight cut (C_bottom shares C's)
-    straight = t[t["eccentricity_mm"] == 0].groupby("set")[["force_N", "dem_contact_fraction_1"]].first()
-    straight.loc["C_bottom"] = straight.loc["C"]
+    t["packing"] = t["run"].map(packing_of)
+    # each set's straight cut on each packing where it was run (C_bottom shares C's)
+    straight = t[t["eccentricity_mm"] == 0].groupby(["set", "packing"])[["force_N", "dem_contact_fraction_1"]].first()
+    straight = pd.concat([straight, straight.loc[["C"]].rename(index={"C": "C_bottom"}, level="set")])
     t = t[t["eccentricity_mm"] > 0].copy()
+    own = pd.Series(list(zip(t["set"], t["packing"])), index=t.index).isin(straight.index)
+    t["straight_packing"] = t["packing"].where(own, DEFAULT_PACKING)
+    ref = straight.loc[list(zip(t["set"], t["straight_packing"]))].set_axis(t.index)
     geo = []
     for r in t.itertuples():
         w = sweep(Orbit(R_M, P_M, r.eccentricity_mm * 1e-3, float(r.nu_1), float(r.lift_1)))
         geo.append((w.arc_ratio, w.contact_fraction, w.removal_ratio))
     t["geom_arc_ratio_1"], t["geom_contact_fraction_1"], t["geom_removal_ratio_1"] = zip(*geo)
     t["deepest_cut_mm"] = P_M * 1e3 + (1 - t["lift_1"]) * t["eccentricity_mm"]
-    t["dem_force_ratio_1"] = t["force_N"] / t["set"].map(straight["force_N"])
-    t["dem_contact_rel_1"] = t["dem_contact_fraction_1"] / t["set"].map(straight["dem_contact_fraction_1"])
+    t["dem_force_ratio_1"] = t["force_N"] / ref["force_N"]
+    t["dem_contact_rel_1"] = t["dem_contact_fraction_1"] / ref["dem_contact_fraction_1"]
     t["dem_over_geom_1"] = t["dem_force_ratio_1"] / t["geom_arc_ratio_1"]
-    cols = ["set", "run", "eccentricity_mm", "nu_1", "lift_1", "deepest_cut_mm", "force_N", "dem_force_ratio_1",
+    cols = ["set", "run", "packing", "straight_packing", "eccentricity_mm", "nu_1", "lift_1", "deepest_cut_mm", "force_N", "dem_force_ratio_1",
             "geom_arc_ratio_1", "dem_over_geom_1", "dem_contact_fraction_1", "dem_contact_rel_1",
             "geom_contact_fraction_1", "geom_removal_ratio_1"]
     return t[cols].round(4)

@@ -780,6 +780,32 @@ def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends
     assert not tr.loc["fr_fn_falls_with_r", "seed_change_in_ci95"]
 
 
+def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):
+    """docs/families_runs/rotary_reduced_5packings: the 12 runs above plus packings 404 and 505 (session 25, 20 runs).
+    F_r/F_n changes -2 % from r 250 to 1000 mm (95 % interval -15 % to +14 %, p 0.75), so the seed's -47 % is excluded;
+    abs(F_s) -16 % (-42 % to +36 %) excludes the seed's -59 %. F_n rises +35 % (+9 % to +74 %, p 0.007; seed +36 %),
+    and F_r rises with it (+37 %; seed -28 %). At one radius F_r/F_n spreads with sd 0.06-0.11 over the packings."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_reduced_5packings"
+    table = pd.read_csv(rec / "family_table.csv")
+    assert sorted(set(table["packing_seed"])) == [202, 303, 404, 505, fam.DEFAULT_PACKING_SEED] and len(table) == 20
+    first = pd.read_csv(ROOT / "docs" / "families_runs" / "rotary_reduced_3packings" / "family_table.csv")
+    assert table[table["packing_seed"].isin(first["packing_seed"])].reset_index(drop=True).equals(first)
+    sd = table.groupby("rotary_radius_full_mm")["rolling_to_normal_ratio_1"].std()
+    assert sd.to_numpy() == pytest.approx([0.069, 0.110, 0.063, 0.092], abs=1e-3)
+    tr = _refit_recorded("rotary", rec, tmp_path)
+    want = {"fr_fn_falls_with_r": (-0.022, -0.148, 0.138, 0.752), "fs_falls_with_r": (-0.158, -0.420, 0.363, 0.419),
+            "fn_rises_with_r": (0.349, 0.090, 0.737, 0.007), "fr_falls_with_r": (0.370, 0.122, 0.731, 0.003)}
+    for trend, (change, lo, hi, p) in want.items():
+        row = tr.loc[trend]
+        assert [row["change_1"], row["change_1_ci95_low"], row["change_1_ci95_high"]] == pytest.approx([change, lo, hi], abs=1e-3)
+        assert row["p_value"] == pytest.approx(p, abs=1e-3)
+    inside = tr["seed_change_in_ci95"].astype(bool)
+    assert inside.to_dict() == {"fs_falls_with_r": False, "fr_fn_falls_with_r": False, "fn_rises_with_r": True,
+                                "fr_falls_with_r": False}
+
+
 def test_trend_confidence_interval_of_the_change_and_whether_it_holds_the_seed_size():
     """trend_table's change_1_ci95_low/high: the change along the line at the ends of the slope's 95 % interval,
     checked against numpy's least squares and scipy's t quantile; seed_change_in_ci95 says whether the seed's change
@@ -810,6 +836,42 @@ def test_trend_confidence_interval_of_the_change_and_whether_it_holds_the_seed_s
     assert [row["change_1_ci95_low"], row["change_1_ci95_high"]] == pytest.approx(want, abs=1e-9)
     assert row["change_1_ci95_low"] < row["change_1"] < row["change_1_ci95_high"]
     assert want[0] <= -0.4702503501894313 <= want[1] and row["seed_change_in_ci95"]  # scatter that cannot tell -40 % from -47 %
+    # a line whose interval reaches y = 0 at r 250 mm: the relative change has no scale there, so no bound
+    rising = 0.02 + 0.1 * np.log(r / 250) + 0.08 * np.array([1, -1, 1, -1, -1, 1, -1, 1, 1, 1, -1, -1])
+    row = fit(rising)
+    b, a = np.polyfit(x, rising, 1)
+    se = np.sqrt(((rising - (a + b * x)) ** 2).sum() / (len(x) - 2) / ((x - x.mean()) ** 2).sum())
+    assert rising.mean() + (b + q * se) * (np.log(250) - x.mean()) < 0 < rising.mean() + b * (np.log(250) - x.mean())
+    assert (row["change_1_ci95_low"], row["change_1_ci95_high"]) == (-np.inf, np.inf) and row["seed_change_in_ci95"]
+
+
+def test_trend_intervals_of_the_recorded_reports():
+    """docs/families_runs/trend_intervals.csv: every recorded report's trends re-fitted with the 95 % interval of their
+    change. It regenerates from the recorded family tables, the re-fitted slopes equal the recorded ones, and the
+    documented readings hold: the linear F_r/F_n rise holds the seed's +93 % (bpm granite, 24 runs), the ODC nu < 1
+    fall the seed's -30 % (smooth cone), while the rotary F_r/F_n on 3 and 5 packings excludes the seed's -47 %."""
+    import importlib.util
+
+    import pandas as pd
+
+    path = ROOT / "docs" / "families_runs" / "trend_intervals.py"
+    spec = importlib.util.spec_from_file_location("trend_intervals", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    fresh = mod.intervals()
+    recorded = pd.read_csv(path.with_suffix(".csv"))
+    assert list(fresh["report"] + "/" + fresh["trend"]) == list(recorded["report"] + "/" + recorded["trend"])
+    num = ["change_1", "change_1_ci95_low", "change_1_ci95_high", "seed_change_1", "p_value"]
+    assert np.allclose(fresh[num].to_numpy(float), recorded[num].to_numpy(float), atol=1e-4, equal_nan=True)
+    assert fresh["slope_as_recorded"].dropna().astype(bool).all()  # empty for trends defined after a report
+    t = fresh.set_index(["report", "trend"])
+    lin = t.loc[("linear_reduced_bpm_granite_replicates", "fr_fn_rises_with_p")]
+    assert (lin["change_1_ci95_low"], lin["change_1_ci95_high"]) == pytest.approx((0.092, 1.972), abs=1e-3)
+    assert lin["seed_change_in_ci95"]
+    odc = t.loc[("odc_smooth/smoothcone_family", "f_falls_with_freq_nu_lt_1_smooth")]
+    assert odc["change_1_ci95_low"] < -0.3046 < odc["change_1_ci95_high"] < 0.3
+    for rep in ("rotary_reduced_3packings", "rotary_reduced_5packings"):
+        assert not t.loc[(rep, "fr_fn_falls_with_r"), "seed_change_in_ci95"]
 
 
 def test_recorded_x1_smooth_cone_cuts_give_the_documented_ratios():

@@ -1002,6 +1002,17 @@ TRENDS: dict[str, tuple[Trend, ...]] = {
               "rotary_radius_full_mm", (), -1, (16.1 / 143.1) / (22.3 / 105.0) - 1,
               "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: Fr/Fn 22.3/105.0 at r 250 -> 16.1/143.1 at r 1000 mm",
               x_range=(250, 1000), log_x=True),
+        # the two forces of the ratio on their own (added in session 25, after the 20 reduced runs had been seen):
+        # seed 002's F_n rises with r at every spacing of its 17-inch, 158 MPa rows (+36 % at S 25, +31 % at S 51) while
+        # F_r falls (-28 %, -25 %), which is why its F_r/F_n falls
+        Trend("fn_rises_with_r", "normal force rises with the path radius r", "force_normal_N_mean_steady",
+              "rotary_radius_full_mm", (), +1, 143.1 / 105.0 - 1,
+              "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: normal force 105.0 kN at r 250 mm -> 143.1 kN at r 1000 mm",
+              x_range=(250, 1000), log_x=True),
+        Trend("fr_falls_with_r", "rolling force falls with the path radius r", "force_rolling_N_mean_steady",
+              "rotary_radius_full_mm", (), -1, 16.1 / 22.3 - 1,
+              "seed 002 Table 2, 432 mm disc, S 25, p 6.4 mm: rolling force 22.3 kN at r 250 mm -> 16.1 kN at r 1000 mm",
+              x_range=(250, 1000), log_x=True),
     ),
     "odc": (
         Trend("f_falls_with_freq_nu_lt_1", "mean force falls with the oscillation frequency when nu < 1",
@@ -1119,7 +1130,16 @@ def trend_table(family: str, table: "Any") -> "Any":
                 out.append(b * (x1 - x0) / abs(y0) if y0 != 0 else float("nan"))
             return float(np.nanmean(out))
 
-        ci_change = sorted(change_at(b) for b in ci) if ci[0] == ci[0] else [float("nan"), float("nan")]
+        # the change over the slope's interval: its min and max on a fine grid (an average of per-group ratios need not be
+        # monotone); unbounded when a group's line reaches y0 = 0 inside the interval (the relative change has no scale)
+        ci_change = [float("nan"), float("nan")]
+        if ci[0] == ci[0]:
+            y0_ends = [[g["_y"].mean() + b * (x0 - g["_x"].mean()) for b in ci] for _, g in t.groupby("_g")]
+            if any(lo * hi <= 0 for lo, hi in y0_ends):
+                ci_change = [-math.inf, math.inf]
+            else:
+                grid = [change_at(b) for b in np.linspace(ci[0], ci[1], 201)]
+                ci_change = [min(grid), max(grid)]
         seed_in = (bool(ci_change[0] <= tr.seed_change <= ci_change[1])
                    if ci_change[0] == ci_change[0] and tr.seed_change == tr.seed_change else None)
         xs = t[tr.x]

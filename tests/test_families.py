@@ -780,6 +780,30 @@ def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends
     assert not tr.loc["fr_fn_falls_with_r", "seed_change_in_ci95"]
 
 
+def test_recorded_linear_runs_with_s25_on_a_second_packing_weaken_the_ratio_trend(tmp_path):
+    """docs/families_runs/linear_reduced_bpm_granite_replicates_28: the 24 granite-card runs plus S 25 mm on packing 202
+    (session 25). The new packing's F_r/F_n falls with p (0.18 -> 0.008) where packing 12345's rose (0.02 -> 0.29), so
+    over 28 runs F_r/F_n rises +41 % with p 0.13 (interval -10 % to +138 %, the seed's +93 % inside); F_n still rises
+    with S (+109 %, p 0.003)."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite_replicates_28"
+    table = pd.read_csv(rec / "family_table.csv")
+    first = pd.read_csv(ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite_replicates" / "family_table.csv")
+    assert len(table) == 28 and set(first["case"]) < set(table["case"])
+    s25 = table[table["spacing_full_mm"] == 25].pivot(index="penetration_full_mm", columns="packing_seed",
+                                                        values="rolling_to_normal_ratio_1")
+    assert s25[202].to_numpy() == pytest.approx([0.182, 0.236, 0.111, 0.008], abs=1e-3)
+    assert s25[fam.DEFAULT_PACKING_SEED].to_numpy() == pytest.approx([0.019, 0.119, 0.262, 0.288], abs=1e-3)
+    tr = _refit_recorded("linear_ccs", rec, tmp_path)
+    fr = tr.loc["fr_fn_rises_with_p"]
+    assert [fr["change_1"], fr["change_1_ci95_low"], fr["change_1_ci95_high"], fr["p_value"]] == \
+        pytest.approx([0.405, -0.102, 1.380, 0.133], abs=1e-3)
+    assert fr["seed_change_in_ci95"]
+    assert tr.loc["fn_rises_with_s", "change_1"] == pytest.approx(1.088, abs=1e-3)
+    assert tr.loc["fn_rises_with_s", "p_value"] == pytest.approx(0.0029, abs=1e-4)
+
+
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):
     """docs/families_runs/rotary_reduced_5packings: the 12 runs above plus packings 404 and 505 (session 25, 20 runs).
     F_r/F_n changes -2 % from r 250 to 1000 mm (95 % interval -15 % to +14 %, p 0.75), so the seed's -47 % is excluded;

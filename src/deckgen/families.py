@@ -1123,19 +1123,20 @@ def trend_table(family: str, table: "Any") -> "Any":
         # relative change of each group's line over the seed's x range, averaged over the groups
         x0, x1 = (np.log(v) for v in tr.x_range) if tr.log_x else tr.x_range
 
+        means = t.groupby("_g")[["_x", "_y"]].mean()
+
+        def y0_at(b: float) -> "Any":  # each group's line at the start of the seed's range
+            return (means["_y"] + b * (x0 - means["_x"])).to_numpy()
+
         def change_at(b: float) -> float:
-            out = []
-            for _, g in t.groupby("_g"):
-                y0 = g["_y"].mean() + b * (x0 - g["_x"].mean())
-                out.append(b * (x1 - x0) / abs(y0) if y0 != 0 else float("nan"))
-            return float(np.nanmean(out))
+            y0 = y0_at(b)
+            return float(np.nanmean([b * (x1 - x0) / abs(v) if v != 0 else float("nan") for v in y0]))
 
         # the change over the slope's interval: its min and max on a fine grid (an average of per-group ratios need not be
         # monotone); unbounded when a group's line reaches y0 = 0 inside the interval (the relative change has no scale)
         ci_change = [float("nan"), float("nan")]
         if ci[0] == ci[0]:
-            y0_ends = [[g["_y"].mean() + b * (x0 - g["_x"].mean()) for b in ci] for _, g in t.groupby("_g")]
-            if any(lo * hi <= 0 for lo, hi in y0_ends):
+            if (y0_at(ci[0]) * y0_at(ci[1]) <= 0).any():
                 ci_change = [-math.inf, math.inf]
             else:
                 grid = [change_at(b) for b in np.linspace(ci[0], ci[1], 201)]

@@ -17,19 +17,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import re
 from pathlib import Path
 
 import pandas as pd
 
+from deckgen.families import DEFAULT_PACKING_SEED as DEFAULT_PACKING  # cases without a _k<seed> suffix
 from deckgen.odc_kinematics import Orbit, sweep
 from deckgen.spec import orbit_lift
 
 HERE = Path(__file__).resolve().parent
 RUNS = HERE.parent
 FAMILY_CASES = HERE.parents[2] / "cases" / "odc" / "reduced"
-DEFAULT_PACKING = 12345  # deckgen.families.DEFAULT_PACKING_SEED: cases without a _k<seed> suffix
 R_M, P_M = 0.010, 0.004
 SETS = {  # set: (table, force column, note)
     "A": (RUNS / "odc_smooth/smoothcone_family/family_table.csv", "force_magnitude_N_mean_cycles_sliding",
@@ -61,7 +60,8 @@ def _rows_of(set_name: str, table: Path, col: str) -> pd.DataFrame:
 
 def _lift_rows() -> pd.DataFrame:
     """The diagnostics of this folder: each ``<case>_summary.json`` (the run's parsed summary) beside its case file
-    ``<case>.yaml`` (here, or the family's in cases/odc/reduced), whose kinematics give the path."""
+    ``<case>.yaml`` (here, or the family's in cases/odc/reduced), whose kinematics give e and the orbit's lift; nu is
+    the summary's (None for a straight cut)."""
     from deckgen.spec import load_case
 
     rows = []
@@ -73,8 +73,8 @@ def _lift_rows() -> pd.DataFrame:
         rows.append({"set": "A", "run": s["case"], "force_N": s["force_magnitude_N_mean_cycles_sliding"],
                      "dem_contact_fraction_1": s["contact_fraction_steady_1"],
                      "eccentricity_mm": k.eccentricity_mm if osc else 0.0,
-                     "nu_1": round(k.speed_m_s / (k.eccentricity_mm * 1e-3 * 2 * math.pi * k.frequency_hz), 3)
-                     if osc else float("inf"), "lift_1": k.orbit_lift if osc else 1.0})
+                     "nu_1": round(s["velocity_ratio_nu_1"], 3) if osc else float("inf"),
+                     "lift_1": k.orbit_lift if osc else 1.0})
     return pd.DataFrame(rows)
 
 

@@ -38,7 +38,7 @@ def _header(path: Path) -> str:
 
 def test_generator_reproduces_committed_files_byte_for_byte():
     files = fam.family_files(ROOT)
-    assert len(files) == 145 + 2 * len(NAMES)  # 145 case files + index.csv and README.md per family
+    assert len(files) == 153 + 2 * len(NAMES)  # 153 case files + index.csv and README.md per family
     for path, text in files.items():
         assert path.is_file(), f"{path} missing (fix: python -m deckgen.families write)"
         assert path.read_text() == text, f"{path} differs from the generator (fix: python -m deckgen.families write)"
@@ -50,7 +50,7 @@ def test_case_counts_per_family():
     counts = {(f, s): len(_files(f, s)) for f in NAMES for s in fam.SCALES}
     assert counts == {
         ("indentation_asymmetric", "full"): 12, ("indentation_asymmetric", "reduced"): 12,
-        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 40,  # 16 + 24 replicate packings
+        ("linear_ccs", "full"): 16, ("linear_ccs", "reduced"): 48,  # 16 + 2 x 4 x 4 replicate packings (S 25, 51, 76, 100)
         ("rotary", "full"): 4, ("rotary", "reduced"): 20,  # 4 + 4 x 4 replicate packings
         ("odc", "full"): 10, ("odc", "reduced"): 31,  # 9 of Table 5.1 + 3 supplementary + 4 long cuts + 6 x1 cuts + 6 + 3 smooth long cuts
     }
@@ -780,30 +780,36 @@ def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends
     assert not tr.loc["fr_fn_falls_with_r", "seed_change_in_ci95"]
 
 
-@pytest.mark.parametrize("runs, before, s25, fr_fn, seed_inside, fn_change", [
+@pytest.mark.parametrize("runs, before, series, fr_fn, seed_inside, fn_change", [
     # S 25 mm on packing 202: its F_r/F_n falls with p (0.18 -> 0.008) where packing 12345's rose (0.02 -> 0.29)
-    (28, "linear_reduced_bpm_granite_replicates", {202: [0.182, 0.236, 0.111, 0.008],
-                                                   12345: [0.019, 0.119, 0.262, 0.288]},
+    (28, "linear_reduced_bpm_granite_replicates", {(25, 202): [0.182, 0.236, 0.111, 0.008],
+                                                   (25, 12345): [0.019, 0.119, 0.262, 0.288]},
      [0.405, -0.102, 1.380, 0.133], True, 1.088),
     # and on packing 303, which falls too (0.45 -> 0.21): the interval now excludes the seed's +93 %
-    (32, "linear_reduced_bpm_granite_replicates_28", {303: [0.447, 0.204, 0.083, 0.205]},
+    (32, "linear_reduced_bpm_granite_replicates_28", {(25, 303): [0.447, 0.204, 0.083, 0.205]},
      [0.133, -0.273, 0.822, 0.572], False, 1.353),
+    # S 51 mm on packings 202 and 303 (session 26): both rise from ~0 to 0.42-0.49, where packing 12345 stayed flat
+    (40, "linear_reduced_bpm_granite_replicates_32", {(51, 202): [-0.065, 0.373, 0.199, 0.486],
+                                                      (51, 303): [0.040, 0.186, 0.229, 0.415],
+                                                      (51, 12345): [0.253, 0.170, 0.280, 0.262]},
+     [0.561, -0.018, 1.698, 0.059], True, 1.310),
 ])
-def test_recorded_linear_runs_with_s25_on_more_packings(tmp_path, runs, before, s25, fr_fn, seed_inside, fn_change):
-    """docs/families_runs/linear_reduced_bpm_granite_replicates_28 and _32 (session 25): the 24 granite-card runs plus
-    S 25 mm on packing 202, then on 303. Over 28 runs F_r/F_n rises +41 % with p (p 0.13, -10 % to +138 %, the seed's
-    +93 % inside); over 32 runs +13 % (p 0.57, -27 % to +82 %, the seed's +93 % excluded), while S >= 76 mm alone keeps
-    the seed inside. F_n rises with S (+109 %, p 0.003; +135 %, p 0.0002)."""
+def test_recorded_linear_runs_on_more_packings(tmp_path, runs, before, series, fr_fn, seed_inside, fn_change):
+    """docs/families_runs/linear_reduced_bpm_granite_replicates_28, _32 (session 25) and _40 (session 26): the 24
+    granite-card runs plus S 25 mm on packing 202, then on 303, then S 51 mm on both. Over 28 runs F_r/F_n rises +41 %
+    with p (p 0.13, -10 % to +138 %, the seed's +93 % inside); over 32 runs +13 % (p 0.57, -27 % to +82 %, the seed's
+    +93 % excluded); over 40 runs +56 % (p 0.059, -2 % to +170 %, the seed inside again), while S >= 76 mm alone keeps
+    the seed inside. F_n rises with S (+109 %, p 0.003; +135 %, p 0.0002; +131 %, p 0.0002)."""
     import pandas as pd
 
     rec = ROOT / "docs" / "families_runs" / f"linear_reduced_bpm_granite_replicates_{runs}"
     table = pd.read_csv(rec / "family_table.csv")
     first = pd.read_csv(ROOT / "docs" / "families_runs" / before / "family_table.csv")
     assert len(table) == runs and set(first["case"]) < set(table["case"])
-    ratio = table[table["spacing_full_mm"] == 25].pivot(index="penetration_full_mm", columns="packing_seed",
-                                                          values="rolling_to_normal_ratio_1")
-    for seed, values in s25.items():
-        assert ratio[seed].to_numpy() == pytest.approx(values, abs=1e-3)
+    for (spacing, seed), values in series.items():
+        one = table[(table["spacing_full_mm"] == spacing) & (table["packing_seed"] == seed)]
+        ratio = one.sort_values("penetration_full_mm")["rolling_to_normal_ratio_1"]
+        assert ratio.to_numpy() == pytest.approx(values, abs=1e-3)
     tr = _refit_recorded("linear_ccs", rec, tmp_path)
     fr = tr.loc["fr_fn_rises_with_p"]
     assert [fr["change_1"], fr["change_1_ci95_low"], fr["change_1_ci95_high"], fr["p_value"]] == pytest.approx(fr_fn, abs=1e-3)

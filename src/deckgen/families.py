@@ -357,9 +357,10 @@ SEED001_PAIRS = tuple((S, p) for S in (25, 51, 76) for p in (1.9, 3.8, 6.4)) + (
 REDUCED_DISC = 1 / 8  # linear_ccs and rotary: disc geometry factor
 REDUCED_PEN = 1 / 2  # linear_ccs and rotary: penetration factor (grains are not scaled)
 #: linear_ccs reduced: extra packing seeds (replicate runs) of the penetration series at these full-scale
-#: spacings, the cheapest three (Fr/Fn vs p scatters with single chip events at this block size; docs/families.md)
+#: spacings (Fr/Fn vs p scatters with single chip events at this block size; docs/families.md). S 25/51/76 first, as
+#: the cheapest; S 100 added in session 26: seed 001's Fr/Fn-with-p numbers are its Table 4 at S 100 mm
 LINEAR_REPLICATE_SEEDS = (202, 303)
-LINEAR_REPLICATE_SPACINGS = (25, 51, 76)
+LINEAR_REPLICATE_SPACINGS = (25, 51, 76, 100)
 #: the packing seed of a case that does not set one (spec default)
 DEFAULT_PACKING_SEED = 12345
 

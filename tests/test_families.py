@@ -793,13 +793,19 @@ def test_recorded_rotary_runs_on_three_packings_do_not_resolve_the_radius_trends
                                                       (51, 303): [0.040, 0.186, 0.229, 0.415],
                                                       (51, 12345): [0.253, 0.170, 0.280, 0.262]},
      [0.561, -0.018, 1.698, 0.059], True, 1.310),
+    # S 100 mm on both (session 26): every (S, p) on three packings; F_r/F_n now rises at p 0.012, the seed inside
+    (48, "linear_reduced_bpm_granite_replicates_40", {(100, 202): [0.159, 0.260, 0.273, 0.251],
+                                                      (100, 303): [0.108, 0.277, 0.254, 0.469],
+                                                      (100, 12345): [0.261, 0.177, 0.159, 0.424]},
+     [0.689, 0.127, 1.719, 0.012], True, 1.925),
 ])
 def test_recorded_linear_runs_on_more_packings(tmp_path, runs, before, series, fr_fn, seed_inside, fn_change):
-    """docs/families_runs/linear_reduced_bpm_granite_replicates_28, _32 (session 25) and _40 (session 26): the 24
-    granite-card runs plus S 25 mm on packing 202, then on 303, then S 51 mm on both. Over 28 runs F_r/F_n rises +41 %
-    with p (p 0.13, -10 % to +138 %, the seed's +93 % inside); over 32 runs +13 % (p 0.57, -27 % to +82 %, the seed's
-    +93 % excluded); over 40 runs +56 % (p 0.059, -2 % to +170 %, the seed inside again), while S >= 76 mm alone keeps
-    the seed inside. F_n rises with S (+109 %, p 0.003; +135 %, p 0.0002; +131 %, p 0.0002)."""
+    """docs/families_runs/linear_reduced_bpm_granite_replicates_28, _32 (session 25), _40 and _48 (session 26): the 24
+    granite-card runs plus S 25 mm on packing 202, then on 303, then S 51 mm on both, then S 100 mm on both. Over 28 runs
+    F_r/F_n rises +41 % with p (p 0.13, -10 % to +138 %, the seed's +93 % inside); over 32 runs +13 % (p 0.57, -27 % to
+    +82 %, the seed's +93 % excluded); over 40 runs +56 % (p 0.059, -2 % to +170 %, the seed inside again); over 48
+    runs +69 % (p 0.012, +13 % to +172 %), while S >= 76 mm alone keeps the seed inside. F_n rises with S (+109 %,
+    p 0.003; +135 %, p 0.0002; +131 %, p 0.0002; +193 %, p 0.00004)."""
     import pandas as pd
 
     rec = ROOT / "docs" / "families_runs" / f"linear_reduced_bpm_granite_replicates_{runs}"
@@ -817,6 +823,38 @@ def test_recorded_linear_runs_on_more_packings(tmp_path, runs, before, series, f
     assert tr.loc["fr_fn_rises_with_p_intact_ridge", "seed_change_in_ci95"]
     assert tr.loc["fn_rises_with_s", "change_1"] == pytest.approx(fn_change, abs=1e-3)
     assert tr.loc["fn_rises_with_s", "p_value"] < 0.005
+
+
+def test_recorded_linear_runs_over_the_wide_window_scatter_less_with_the_same_slope(tmp_path):
+    """docs/families_runs/linear_window_wide_16 (session 26): the 16 runs of S 51 and 100 mm on packings 202 and 303 read
+    over 0.3-1.0 of the travel; _48 holds the same runs over the family window (contact patch at 40-60 % of the block).
+    The wider window cuts the mean difference in F_r/F_n between the two packings at one (S, p) by 40 % (0.087 ->
+    0.053), lowers F_n in 15 of 16 runs, and leaves the slope of F_r/F_n with p where it was (0.048 -> 0.046 per mm)."""
+    import pandas as pd
+
+    from deckgen.families import trend_table
+
+    wide = pd.read_csv(ROOT / "docs" / "families_runs" / "linear_window_wide_16" / "family_table.csv")
+    fam_window = pd.read_csv(ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv")
+    assert len(wide) == 16 and set(wide["packing_seed"]) == {202, 303} and set(wide["spacing_full_mm"]) == {51, 100}
+    keys = ["spacing_full_mm", "penetration_full_mm", "packing_seed"]
+    both = wide.merge(fam_window[fam_window["case"].isin(wide["case"])], on=keys, suffixes=("_wide", "_fam"))
+    assert len(both) == 16
+
+    def packing_gap(which):
+        ratio = both.pivot_table(index=keys[:2], columns="packing_seed", values=f"rolling_to_normal_ratio_1_{which}")
+        return (ratio[202] - ratio[303]).abs().mean()
+
+    assert packing_gap("fam") == pytest.approx(0.0873, abs=1e-4)
+    assert packing_gap("wide") == pytest.approx(0.0525, abs=1e-4)
+    assert (both["force_normal_N_mean_steady_wide"] < both["force_normal_N_mean_steady_fam"]).sum() == 15
+    slopes = {}
+    for which, table in (("fam", fam_window[fam_window["case"].isin(wide["case"])]), ("wide", wide)):
+        row = trend_table("linear_ccs", table).set_index("trend").loc["fr_fn_rises_with_p"]
+        slopes[which] = (row["slope"], row["p_value"])
+    assert slopes["fam"][0] == pytest.approx(0.0479, abs=1e-4) and slopes["wide"][0] == pytest.approx(0.0462, abs=1e-4)
+    assert slopes["fam"][1] == pytest.approx(0.0014, abs=1e-4) and slopes["wide"][1] < 1e-4
+    _refit_recorded("linear_ccs", ROOT / "docs" / "families_runs" / "linear_window_wide_16", tmp_path)
 
 
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):

@@ -837,8 +837,9 @@ def test_recorded_linear_runs_over_the_wide_window_scatter_less_with_the_same_sl
     wide = pd.read_csv(ROOT / "docs" / "families_runs" / "linear_window_wide_16" / "family_table.csv")
     fam_window = pd.read_csv(ROOT / "docs" / "families_runs" / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv")
     assert len(wide) == 16 and set(wide["packing_seed"]) == {202, 303} and set(wide["spacing_full_mm"]) == {51, 100}
+    same_runs = fam_window[fam_window["case"].isin(wide["case"])]
     keys = ["spacing_full_mm", "penetration_full_mm", "packing_seed"]
-    both = wide.merge(fam_window[fam_window["case"].isin(wide["case"])], on=keys, suffixes=("_wide", "_fam"))
+    both = wide.merge(same_runs, on=keys, suffixes=("_wide", "_fam"))
     assert len(both) == 16
 
     def packing_gap(which):
@@ -848,13 +849,11 @@ def test_recorded_linear_runs_over_the_wide_window_scatter_less_with_the_same_sl
     assert packing_gap("fam") == pytest.approx(0.0873, abs=1e-4)
     assert packing_gap("wide") == pytest.approx(0.0525, abs=1e-4)
     assert (both["force_normal_N_mean_steady_wide"] < both["force_normal_N_mean_steady_fam"]).sum() == 15
-    slopes = {}
-    for which, table in (("fam", fam_window[fam_window["case"].isin(wide["case"])]), ("wide", wide)):
-        row = trend_table("linear_ccs", table).set_index("trend").loc["fr_fn_rises_with_p"]
-        slopes[which] = (row["slope"], row["p_value"])
-    assert slopes["fam"][0] == pytest.approx(0.0479, abs=1e-4) and slopes["wide"][0] == pytest.approx(0.0462, abs=1e-4)
-    assert slopes["fam"][1] == pytest.approx(0.0014, abs=1e-4) and slopes["wide"][1] < 1e-4
-    _refit_recorded("linear_ccs", ROOT / "docs" / "families_runs" / "linear_window_wide_16", tmp_path)
+    fam_fit = trend_table("linear_ccs", same_runs).set_index("trend").loc["fr_fn_rises_with_p"]
+    wide_fit = _refit_recorded("linear_ccs", ROOT / "docs" / "families_runs" / "linear_window_wide_16", tmp_path).loc[
+        "fr_fn_rises_with_p"]
+    assert fam_fit["slope"] == pytest.approx(0.0479, abs=1e-4) and wide_fit["slope"] == pytest.approx(0.0462, abs=1e-4)
+    assert fam_fit["p_value"] == pytest.approx(0.0014, abs=1e-4) and wide_fit["p_value"] < 1e-4
 
 
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):

@@ -219,10 +219,10 @@ def test_reduced_scale_numbers_follow_the_stated_factors():
         assert c.cutter.diameter_mm == pytest.approx(431.8 / 8, abs=1e-3)
     assert sorted(set(c.kinematics.penetration_mm for c in _cases("linear_ccs", "reduced"))) == [0.95, 1.9, 3.2, 3.8]
     assert sorted(set(c.kinematics.neighbour_spacing_mm for c in _cases("linear_ccs", "reduced"))) == [3.125, 6.375, 9.5, 12.5]
-    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25] * 5 + [62.5] * 5 + [125] * 5 + [375] * 5
+    assert sorted(c.kinematics.rotary_radius_mm for c in _cases("rotary", "reduced")) == [31.25] * 7 + [62.5] * 7 + [125] * 7 + [375] * 7
     # the rotary window: the last 70 % of the travel (the middle window of linear_ccs holds one chip event on its block)
     assert {c.outputs.steady_window for c in _cases("rotary", "reduced")} == {(0.3, 1.0)}
-    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [303] * 4 + [404] * 4 + [505] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
+    assert sorted(c.packing.seed for c in _cases("rotary", "reduced")) == [202] * 4 + [303] * 4 + [404] * 4 + [505] * 4 + [606] * 4 + [707] * 4 + [fam.DEFAULT_PACKING_SEED] * 4
     fulls = {c.name.replace("_full_", "_"): c for c in _cases("odc", "full")}
     sup = {f"odc_red_s{sim}": (e, f, v) for sim, e, f, v, _ in fam.ODC_SUPPLEMENTARY}
     for c in _cases("odc", "reduced"):

@@ -468,7 +468,7 @@ SEED002_RADII = (250, 500, 1000, 3000)
 #: the block face at 59 % of the travel), alike at every radius. Chosen after looking at the session-22 runs
 #: (docs/families.md, "The rotary window"), and tested on the packing-seed-202 replicates run after it was fixed.
 ROTARY_REDUCED_WINDOW = (0.3, 1.0)
-ROTARY_REPLICATE_SEEDS = (202, 303, 404, 505)
+ROTARY_REPLICATE_SEEDS = (202, 303, 404, 505, 606, 707)
 
 
 def rotary() -> list[CaseDef]:

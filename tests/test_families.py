@@ -972,3 +972,36 @@ def test_recorded_x1_smooth_cone_cuts_give_the_documented_ratios():
     assert tab["x4_" + q].to_numpy() == pytest.approx(x4.loc[tab["family_case"], q].to_numpy(), rel=1e-12)
     ratio_x4 = x4.loc["odc_red_s103_long_smoothcone", q] / x4.loc["odc_red_s16_long_smoothcone", q]
     assert ratio_x4 == pytest.approx(0.494, abs=2e-3)
+
+
+def test_rotary_fixed_face_geometry_follows_the_deck_path():
+    """docs/families_runs/rotary_fixed_face.py (session 27) places the front of the contact chord on the deck's rotary
+    path: checked against the golden tiny_rotary deck's variables (start xc0, axis (ax_x, ax_y), r_rot, yaw_rate), and
+    on the family's reduced cases it gives the gaps to the fixed xmax grains quoted in docs/families.md (6.9 / 3.1 / 2.2
+    / 1.9 mm at the end of the travel for r 250 / 500 / 1000 / 3000 mm)."""
+    import importlib.util
+
+    import yaml
+
+    spec = importlib.util.spec_from_file_location("rotary_fixed_face", ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
+    geo = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(geo)
+    case = yaml.safe_load((ROOT / "tests" / "data" / "cases" / "tiny_rotary.yaml").read_text())
+    deck = (ROOT / "tests" / "data" / "golden" / "tiny_rotary" / "in.deck").read_text()
+    var = {m[1]: float(m[2]) for m in re.finditer(r"^variable\s+(\w+)\s+index\s+(\S+)", deck, re.M)}
+    k = case["kinematics"]
+    chord_mm = -var["xc0"] * 1e3 - k["start_clearance_mm"]  # the deck starts the chord front at the clearance
+    assert var["ax_x"] == var["xc0"] and var["ax_y"] == pytest.approx(var["r_rot"])
+    for f in (0.0, 0.5, 1.0):
+        t = f * k["travel_mm"] * 1e-3 / k["speed_m_s"]
+        phi = var["yaw_rate"] * t
+        xc, yc = var["ax_x"] + var["r_rot"] * math.sin(phi), var["ax_y"] - var["r_rot"] * math.cos(phi)
+        x, y, yaw = geo.front_path(case, f)
+        assert [x, y, yaw] == pytest.approx([xc * 1e3 + chord_mm * math.cos(phi), yc * 1e3 + chord_mm * math.sin(phi),
+                                             math.degrees(phi)], abs=1e-6)
+    gaps = []
+    for r in (250, 500, 1000, 3000):
+        fam_case = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}.yaml").read_text())
+        x, _, _ = geo.front_path(fam_case, 1.0)
+        gaps.append(fam_case["specimen"]["length_mm"] - geo.FIXED_SLAB_MM - x)
+    assert gaps == pytest.approx([6.9, 3.1, 2.2, 1.9], abs=0.05)

@@ -705,6 +705,26 @@ def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
     assert list(fam.family_table(index, [c], variants=True)["case"]) == ["odc_red_s11_long"]
 
 
+def _assert_trend_rows(tr, want: dict) -> None:
+    """Each trend of ``want`` (trend -> change, its 95 % interval low and high, p) in the re-fitted trends ``tr``."""
+    for trend, (change, lo, hi, p) in want.items():
+        row = tr.loc[trend]
+        assert [row["change_1"], row["change_1_ci95_low"], row["change_1_ci95_high"]] == pytest.approx([change, lo, hi], abs=1e-3)
+        assert row["p_value"] == pytest.approx(p, abs=1e-3)
+
+
+def _assert_rotary_packings_report(rec: Path, table, tmp_path: Path, sd_by_r: list[float], want: dict) -> None:
+    """A recorded rotary report over several packings: the packings' sd of F_r/F_n at each radius, the re-fitted trends
+    (``want`` as :func:`_assert_trend_rows`), and which trends hold the seed's change in their 95 % interval (only
+    the normal force's rise, in every such report so far)."""
+    sd = table.groupby("rotary_radius_full_mm")["rolling_to_normal_ratio_1"].std()
+    assert sd.to_numpy() == pytest.approx(sd_by_r, abs=1e-3)
+    tr = _refit_recorded("rotary", rec, tmp_path)
+    _assert_trend_rows(tr, want)
+    assert tr["seed_change_in_ci95"].astype(bool).to_dict() == {
+        "fs_falls_with_r": False, "fr_fn_falls_with_r": False, "fn_rises_with_r": True, "fr_falls_with_r": False}
+
+
 def _refit_recorded(family: str, rec: Path, tmp_path: Path):
     """The trends of the recorded family table ``rec``/family_table.csv, re-fitted by `deckgen.families combine`; their
     slopes must equal the recorded ``rec``/trends.csv."""
@@ -868,18 +888,9 @@ def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but
     assert sorted(set(table["packing_seed"])) == [202, 303, 404, 505, fam.DEFAULT_PACKING_SEED] and len(table) == 20
     first = pd.read_csv(ROOT / "docs" / "families_runs" / "rotary_reduced_3packings" / "family_table.csv")
     assert table[table["packing_seed"].isin(first["packing_seed"])].reset_index(drop=True).equals(first)
-    sd = table.groupby("rotary_radius_full_mm")["rolling_to_normal_ratio_1"].std()
-    assert sd.to_numpy() == pytest.approx([0.069, 0.110, 0.063, 0.092], abs=1e-3)
-    tr = _refit_recorded("rotary", rec, tmp_path)
-    want = {"fr_fn_falls_with_r": (-0.022, -0.148, 0.138, 0.752), "fs_falls_with_r": (-0.158, -0.420, 0.363, 0.419),
-            "fn_rises_with_r": (0.349, 0.090, 0.737, 0.007), "fr_falls_with_r": (0.370, 0.122, 0.731, 0.003)}
-    for trend, (change, lo, hi, p) in want.items():
-        row = tr.loc[trend]
-        assert [row["change_1"], row["change_1_ci95_low"], row["change_1_ci95_high"]] == pytest.approx([change, lo, hi], abs=1e-3)
-        assert row["p_value"] == pytest.approx(p, abs=1e-3)
-    inside = tr["seed_change_in_ci95"].astype(bool)
-    assert inside.to_dict() == {"fs_falls_with_r": False, "fr_fn_falls_with_r": False, "fn_rises_with_r": True,
-                                "fr_falls_with_r": False}
+    _assert_rotary_packings_report(rec, table, tmp_path, [0.069, 0.110, 0.063, 0.092], {
+        "fr_fn_falls_with_r": (-0.022, -0.148, 0.138, 0.752), "fs_falls_with_r": (-0.158, -0.420, 0.363, 0.419),
+        "fn_rises_with_r": (0.349, 0.090, 0.737, 0.007), "fr_falls_with_r": (0.370, 0.122, 0.731, 0.003)})
 
 
 def test_trend_confidence_interval_of_the_change_and_whether_it_holds_the_seed_size():
@@ -1005,3 +1016,35 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
         x, _, _ = geo.front_path(fam_case, 1.0)
         gaps.append(fam_case["specimen"]["length_mm"] - geo.FIXED_SLAB_MM - x)
     assert gaps == pytest.approx([6.9, 3.1, 2.2, 1.9], abs=0.05)
+
+
+def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defined_after_five(tmp_path):
+    """docs/families_runs/rotary_reduced_7packings (session 27): the 20 runs of five packings plus packings 606 and 707,
+    run to test the two force trends defined after the 20 runs. Over 28 runs F_n rises +34 % from r 250 to 1000 mm
+    (+10 % to +69 %, p 0.004; seed +36 %) and F_r +28 % (+6 % to +58 %, p 0.010; the seed's -28 % excluded); F_r/F_n
+    -8 % (-18 % to +5 %, p 0.20) still excludes the seed's -47 %. In both new packings F_n and F_r at r 1000 mm exceed
+    r 250 mm's. Re-read over 0.3-0.65 and 0.65-1.0 of the travel (window_*), the 8 new runs' F_n rises alike along the
+    log-r line in both halves (+34 %, +31 %), though the chord front is >= 9.7 mm from the fixed xmax grains over the
+    first half at every r."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_reduced_7packings"
+    table = pd.read_csv(rec / "family_table.csv")
+    five = pd.read_csv(ROOT / "docs" / "families_runs" / "rotary_reduced_5packings" / "family_table.csv")
+    assert len(table) == 28 and set(five["case"]) < set(table["case"])
+    assert sorted(set(table["packing_seed"]) - set(five["packing_seed"])) == [606, 707]
+    new = table[table["packing_seed"].isin([606, 707])]
+    for v, want in {"force_normal_N_mean_steady": {606: (118.6, 179.0), 707: (44.3, 161.9)},
+                    "force_rolling_N_mean_steady": {606: (55.8, 59.6), 707: (22.6, 61.1)}}.items():
+        piv = new.pivot(index="rotary_radius_full_mm", columns="packing_seed", values=v)
+        for seed, (at250, at1000) in want.items():
+            assert [piv.loc[250, seed], piv.loc[1000, seed]] == pytest.approx([at250, at1000], abs=0.1)
+    _assert_rotary_packings_report(rec, table, tmp_path, [0.060, 0.101, 0.054, 0.116], {
+        "fr_fn_falls_with_r": (-0.076, -0.177, 0.047, 0.199), "fs_falls_with_r": (-0.050, -0.320, 0.456, 0.783),
+        "fn_rises_with_r": (0.340, 0.098, 0.692, 0.004), "fr_falls_with_r": (0.276, 0.063, 0.576, 0.010)})
+    halves = {}
+    for half in ("0.3_0.65", "0.65_1.0"):
+        part = pd.read_csv(rec / f"window_{half}" / "family_table.csv")
+        assert sorted(part["case"]) == sorted(new["case"])
+        halves[half] = _refit_recorded("rotary", rec / f"window_{half}", tmp_path / half).loc["fn_rises_with_r", "change_1"]
+    assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)

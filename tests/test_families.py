@@ -1048,3 +1048,24 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
         assert sorted(part["case"]) == sorted(new["case"])
         halves[half] = _refit_recorded("rotary", rec / f"window_{half}", tmp_path / half).loc["fn_rises_with_r", "change_1"]
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
+
+
+def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
+    """docs/families_runs/rotary_block40 (session 27): packing 606 at r 250 and 1000 mm on a 40 mm block (the chord
+    front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family cases:
+    F_n still rises from r 250 to r 1000 mm (80.5 -> 183.0 N, +127 %), F_r with it (45.8 -> 77.4 N)."""
+    import pandas as pd
+    import yaml
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_block40"
+    table = pd.read_csv(rec / "report" / "family_table.csv").set_index("rotary_radius_full_mm")
+    assert list(table["variant_case"]) == ["rot_red_r250_k606_block40", "rot_red_r1000_k606_block40"]
+    assert (table["case"] == ["rot_red_r250_k606", "rot_red_r1000_k606"]).all() and (table["n_grains"] == 4052).all()
+    for r in (250, 1000):  # the diagnostic differs from its family case in the name and the block length only
+        diag = yaml.safe_load((rec / f"diagnostic_r{r}_k606_block40.yaml").read_text())
+        base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}_k606.yaml").read_text())
+        assert diag["specimen"].pop("length_mm") == 40 and base["specimen"].pop("length_mm") == 26
+        assert {**diag, "name": base["name"]} == base
+    fn, fr = table["force_normal_N_mean_steady"], table["force_rolling_N_mean_steady"]
+    assert [fn[250], fn[1000], fr[250], fr[1000]] == pytest.approx([80.5, 183.0, 45.8, 77.4], abs=0.05)
+    assert fn[1000] / fn[250] - 1 == pytest.approx(1.272, abs=1e-3)

@@ -994,13 +994,15 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
 
     import yaml
 
+    from deckgen.spec import load_case
+
     spec = importlib.util.spec_from_file_location("rotary_fixed_face", ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
     geo = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(geo)
-    case = yaml.safe_load((ROOT / "tests" / "data" / "cases" / "tiny_rotary.yaml").read_text())
+    case_path = ROOT / "tests" / "data" / "cases" / "tiny_rotary.yaml"
+    case, k = load_case(case_path), yaml.safe_load(case_path.read_text())["kinematics"]
     deck = (ROOT / "tests" / "data" / "golden" / "tiny_rotary" / "in.deck").read_text()
     var = {m[1]: float(m[2]) for m in re.finditer(r"^variable\s+(\w+)\s+index\s+(\S+)", deck, re.M)}
-    k = case["kinematics"]
     chord_mm = -var["xc0"] * 1e3 - k["start_clearance_mm"]  # the deck starts the chord front at the clearance
     assert var["ax_x"] == var["xc0"] and var["ax_y"] == pytest.approx(var["r_rot"])
     for f in (0.0, 0.5, 1.0):
@@ -1012,9 +1014,9 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
                                              math.degrees(phi)], abs=1e-6)
     gaps = []
     for r in (250, 500, 1000, 3000):
-        fam_case = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}.yaml").read_text())
+        fam_case = load_case(ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}.yaml")
         x, _, _ = geo.front_path(fam_case, 1.0)
-        gaps.append(fam_case["specimen"]["length_mm"] - geo.FIXED_SLAB_MM - x)
+        gaps.append(fam_case.specimen.length_mm - geo.FIXED_SLAB_MM - x)
     assert gaps == pytest.approx([6.9, 3.1, 2.2, 1.9], abs=0.05)
 
 

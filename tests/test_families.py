@@ -1018,6 +1018,20 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
         x, _, _ = geo.front_path(fam_case, 1.0)
         gaps.append(fam_case.specimen.length_mm - geo.FIXED_SLAB_MM - x)
     assert gaps == pytest.approx([6.9, 3.1, 2.2, 1.9], abs=0.05)
+    # the chord front stands outside the path circle by ~ (half chord)^2 / 2r (session 28): 2.50 mm at reduced r 250 mm,
+    # 1.60 tip widths; the full-scale r 250 mm case 5.39 mm, 0.43 tip widths; the straight cut 0
+    half_chord = math.sqrt(2 * 26.9875 * 3.2 - 3.2**2)
+    offsets = [geo.groove_offset_mm(load_case(ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}.yaml"))
+               for r in (250, 500, 1000, 3000)]
+    assert offsets == pytest.approx([2.50, 1.29, 0.65, 0.22], abs=0.005)
+    assert offsets[2] == pytest.approx(half_chord**2 / (2 * 125.0), rel=0.01)
+    full = load_case(ROOT / "cases" / "rotary" / "full" / "rot_full_r250.yaml")
+    assert geo.groove_offset_mm(full) / full.cutter.tip_width_mm == pytest.approx(0.43, abs=0.005)
+    assert geo.groove_offset_mm(load_case(ROOT / "cases" / "linear_ccs" / "reduced" / "lin_red_s100_p6p4.yaml")) == 0.0
+    # the 66 mm wide block (session 28) moves the free side face 12 mm further out: 16.8 mm from the front at r 250 mm
+    wide = load_case(ROOT / "docs" / "families_runs" / "rotary_wide66" / "diagnostic_r250_k202_wide66.yaml")
+    _, y, _ = geo.front_path(wide, 1.0)
+    assert wide.specimen.width_mm / 2 - y == pytest.approx(16.8, abs=0.05)
 
 
 def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defined_after_five(tmp_path):

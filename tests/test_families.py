@@ -1066,6 +1066,54 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
 
 
+def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit():
+    """docs/families_runs/rotary_wide66 (session 28): the family cases on a 66 mm wide block, where the chord front ends
+    the r 250 mm travel 16.8 mm from the free side face instead of 4.8 mm. Four packings at r 250 mm average F_n 125.3 N
+    (42 mm block, seven packings: 100.5 N; r >= 500 mm there 176-188 N), Welch p 0.25; F_r 50.6 N against 45.8 N
+    (p 0.59). On the two packings also run at r 1000 mm F_n still rises (x1.27, x1.22) and F_r with it (x1.27, x2.27)."""
+    import importlib.util
+
+    import pandas as pd
+    import yaml
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_wide66"
+    table = pd.read_csv(rec / "report" / "family_table.csv")
+    assert sorted(table["variant_case"]) == sorted(f"rot_red_r{r}_k{k}_wide66" for r, k in
+                                                   [(250, 202), (250, 303), (250, 404), (250, 505), (1000, 202), (1000, 303)])
+    assert table["run_completed"].all() and table["n_grains"].between(4129, 4165).all()
+    for name in table["variant_case"]:  # the diagnostic differs from its family case in the name and the width only
+        diag = yaml.safe_load((rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml").read_text())
+        base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"{name.removesuffix('_wide66')}.yaml").read_text())
+        assert diag["specimen"].pop("width_mm") == 66 and base["specimen"].pop("width_mm") == 42
+        assert {**diag, "name": base["name"]} == base
+    spec = importlib.util.spec_from_file_location("wide_compare", rec / "compare.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    c = mod.compare().set_index("quantity")
+    assert c.loc["F_n N", ["wide_r250_mean", "narrow_r250_mean", "welch_p"]].to_list() == pytest.approx(
+        [125.26, 100.46, 0.250], abs=5e-3)
+    assert c.loc["F_r N", ["wide_r250_mean", "narrow_r250_mean", "welch_p"]].to_list() == pytest.approx(
+        [50.63, 45.81, 0.593], abs=5e-3)
+    assert c.loc["F_n N", "wide_r250_n"] == 4 and c.loc["F_n N", "narrow_r250_n"] == 7
+    assert c.loc["F_n N", "wide_r1000_over_r250_same_packing"] == pytest.approx([1.266, 1.224], abs=1e-3)
+    assert c.loc["F_r N", "wide_r1000_over_r250_same_packing"] == pytest.approx([1.266, 2.269], abs=1e-3)
+    # the wide r 250 mean closes under a third of the gap to the 42 mm block's r >= 500 mm runs
+    narrow = pd.read_csv(rec.parent / "rotary_reduced_7packings" / "family_table.csv")
+    upper = narrow.loc[narrow["rotary_radius_full_mm"] >= 500, "force_normal_N_mean_steady"].mean()
+    closed = (c.loc["F_n N", "wide_r250_mean"] - c.loc["F_n N", "narrow_r250_mean"]) / (upper - c.loc["F_n N", "narrow_r250_mean"])
+    assert 0.25 < closed < 0.35
+    # re-read over the window halves (post hoc): the wide block lifts the late half at r 250 mm, hardly the early one
+    halves = {}
+    for w in ("0.3_0.65", "0.65_1.0"):
+        wide = pd.read_csv(rec / f"window_{w}" / "family_table.csv")
+        old = pd.read_csv(rec.parent / "rotary_reduced_7packings" / f"window_{w}" / "family_table.csv")
+        fn = "force_normal_N_mean_steady"
+        halves[w] = [wide.loc[wide["rotary_radius_full_mm"] == 250, fn].mean(),
+                     old.loc[old["rotary_radius_full_mm"] == 250, fn].mean()]
+    assert halves["0.3_0.65"] == pytest.approx([100.2, 79.7], abs=0.05)
+    assert halves["0.65_1.0"] == pytest.approx([150.3, 83.2], abs=0.05)
+
+
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     """docs/families_runs/rotary_block40 (session 27): packing 606 at r 250 and 1000 mm on a 40 mm block (the chord
     front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family cases:

@@ -1115,21 +1115,28 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
 
 
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
-    """docs/families_runs/rotary_block40 (session 27): packing 606 at r 250 and 1000 mm on a 40 mm block (the chord
-    front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family cases:
-    F_n still rises from r 250 to r 1000 mm (80.5 -> 183.0 N, +127 %), F_r with it (45.8 -> 77.4 N)."""
+    """docs/families_runs/rotary_block40 (sessions 27-28): packings 606 and 707 at r 250 and 1000 mm on a 40 mm block
+    (the chord front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family
+    cases: F_n still rises from r 250 to r 1000 mm on both packings (606: 80.5 -> 183.0 N, +127 %; 707, run in session 28:
+    106.0 -> 154.8 N, +46 %, above prediction B1's +15 %), F_r with it (45.8 -> 77.4 N; 50.7 -> 53.8 N)."""
     import pandas as pd
     import yaml
 
     rec = ROOT / "docs" / "families_runs" / "rotary_block40"
-    table = pd.read_csv(rec / "report" / "family_table.csv").set_index("rotary_radius_full_mm")
-    assert list(table["variant_case"]) == ["rot_red_r250_k606_block40", "rot_red_r1000_k606_block40"]
-    assert (table["case"] == ["rot_red_r250_k606", "rot_red_r1000_k606"]).all() and (table["n_grains"] == 4052).all()
+    table = pd.read_csv(rec / "report" / "family_table.csv").set_index(["packing_seed", "rotary_radius_full_mm"])
+    assert sorted(table["variant_case"]) == sorted(f"rot_red_r{r}_k{k}_block40" for r in (250, 1000) for k in (606, 707))
+    assert (table["case"] + "_block40" == table["variant_case"]).all() and table["run_completed"].all()
+    assert list(table["n_grains"].sort_index()) == [4052, 4052, 4056, 4056]
     for r in (250, 1000):  # the diagnostic differs from its family case in the name and the block length only
-        diag = yaml.safe_load((rec / f"diagnostic_r{r}_k606_block40.yaml").read_text())
-        base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}_k606.yaml").read_text())
-        assert diag["specimen"].pop("length_mm") == 40 and base["specimen"].pop("length_mm") == 26
-        assert {**diag, "name": base["name"]} == base
+        for k in (606, 707):
+            diag = yaml.safe_load((rec / f"diagnostic_r{r}_k{k}_block40.yaml").read_text())
+            base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}_k{k}.yaml").read_text())
+            assert diag["specimen"].pop("length_mm") == 40 and base["specimen"].pop("length_mm") == 26
+            assert {**diag, "name": base["name"]} == base
     fn, fr = table["force_normal_N_mean_steady"], table["force_rolling_N_mean_steady"]
-    assert [fn[250], fn[1000], fr[250], fr[1000]] == pytest.approx([80.5, 183.0, 45.8, 77.4], abs=0.05)
-    assert fn[1000] / fn[250] - 1 == pytest.approx(1.272, abs=1e-3)
+    assert [fn[606, 250], fn[606, 1000], fr[606, 250], fr[606, 1000]] == pytest.approx([80.5, 183.0, 45.8, 77.4], abs=0.05)
+    assert [fn[707, 250], fn[707, 1000], fr[707, 250], fr[707, 1000]] == pytest.approx([106.0, 154.8, 50.7, 53.8], abs=0.05)
+    assert fn[606, 1000] / fn[606, 250] - 1 == pytest.approx(1.272, abs=1e-3)
+    assert fn[707, 1000] / fn[707, 250] - 1 == pytest.approx(0.461, abs=1e-3)
+    trend = pd.read_csv(rec / "report" / "trends.csv").set_index("trend")
+    assert trend.loc["fn_rises_with_r", ["change_1", "p_value"]].to_list() == pytest.approx([0.811, 0.058], abs=1e-3)

@@ -1020,7 +1020,7 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
     assert gaps == pytest.approx([6.9, 3.1, 2.2, 1.9], abs=0.05)
     # the chord front stands outside the path circle by ~ (half chord)^2 / 2r (session 28): 2.50 mm at reduced r 250 mm,
     # 1.60 tip widths; the full-scale r 250 mm case 5.39 mm, 0.43 tip widths; the straight cut 0
-    half_chord = math.sqrt(2 * 26.9875 * 3.2 - 3.2**2)
+    half_chord = fam.half_chord_mm(26.9875, 3.2)
     offsets = [geo.groove_offset_mm(load_case(ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}.yaml"))
                for r in (250, 500, 1000, 3000)]
     assert offsets == pytest.approx([2.50, 1.29, 0.65, 0.22], abs=0.005)
@@ -1066,6 +1066,17 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
 
 
+def _assert_diagnostic_differs_only_in(diag_path: Path, field: str, diag_value: float, base_value: float) -> None:
+    """A rotary diagnostic case ``<family case>_<suffix>`` differs from its family case (cases/rotary/reduced) in the
+    name and in ``specimen.<field>`` only (``diag_value`` there, ``base_value`` in the family case)."""
+    import yaml
+
+    diag = yaml.safe_load(diag_path.read_text())
+    base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"{diag['name'].rsplit('_', 1)[0]}.yaml").read_text())
+    assert diag["specimen"].pop(field) == diag_value and base["specimen"].pop(field) == base_value
+    assert {**diag, "name": base["name"]} == base
+
+
 def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit():
     """docs/families_runs/rotary_wide66 (session 28): the family cases on a 66 mm wide block, where the chord front ends
     the r 250 mm travel 16.8 mm from the free side face instead of 4.8 mm. Four packings at r 250 mm average F_n 125.3 N
@@ -1074,18 +1085,14 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
     import importlib.util
 
     import pandas as pd
-    import yaml
 
     rec = ROOT / "docs" / "families_runs" / "rotary_wide66"
     table = pd.read_csv(rec / "report" / "family_table.csv")
     assert sorted(table["variant_case"]) == sorted(f"rot_red_r{r}_k{k}_wide66" for r, k in
                                                    [(250, 202), (250, 303), (250, 404), (250, 505), (1000, 202), (1000, 303)])
     assert table["run_completed"].all() and table["n_grains"].between(4129, 4165).all()
-    for name in table["variant_case"]:  # the diagnostic differs from its family case in the name and the width only
-        diag = yaml.safe_load((rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml").read_text())
-        base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"{name.removesuffix('_wide66')}.yaml").read_text())
-        assert diag["specimen"].pop("width_mm") == 66 and base["specimen"].pop("width_mm") == 42
-        assert {**diag, "name": base["name"]} == base
+    for name in table["variant_case"]:
+        _assert_diagnostic_differs_only_in(rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml", "width_mm", 66, 42)
     spec = importlib.util.spec_from_file_location("wide_compare", rec / "compare.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
@@ -1120,19 +1127,15 @@ def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     cases: F_n still rises from r 250 to r 1000 mm on both packings (606: 80.5 -> 183.0 N, +127 %; 707, run in session 28:
     106.0 -> 154.8 N, +46 %, above prediction B1's +15 %), F_r with it (45.8 -> 77.4 N; 50.7 -> 53.8 N)."""
     import pandas as pd
-    import yaml
 
     rec = ROOT / "docs" / "families_runs" / "rotary_block40"
     table = pd.read_csv(rec / "report" / "family_table.csv").set_index(["packing_seed", "rotary_radius_full_mm"])
     assert sorted(table["variant_case"]) == sorted(f"rot_red_r{r}_k{k}_block40" for r in (250, 1000) for k in (606, 707))
     assert (table["case"] + "_block40" == table["variant_case"]).all() and table["run_completed"].all()
     assert list(table["n_grains"].sort_index()) == [4052, 4052, 4056, 4056]
-    for r in (250, 1000):  # the diagnostic differs from its family case in the name and the block length only
+    for r in (250, 1000):
         for k in (606, 707):
-            diag = yaml.safe_load((rec / f"diagnostic_r{r}_k{k}_block40.yaml").read_text())
-            base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"rot_red_r{r}_k{k}.yaml").read_text())
-            assert diag["specimen"].pop("length_mm") == 40 and base["specimen"].pop("length_mm") == 26
-            assert {**diag, "name": base["name"]} == base
+            _assert_diagnostic_differs_only_in(rec / f"diagnostic_r{r}_k{k}_block40.yaml", "length_mm", 40, 26)
     fn, fr = table["force_normal_N_mean_steady"], table["force_rolling_N_mean_steady"]
     assert [fn[606, 250], fn[606, 1000], fr[606, 250], fr[606, 1000]] == pytest.approx([80.5, 183.0, 45.8, 77.4], abs=0.05)
     assert [fn[707, 250], fn[707, 1000], fr[707, 250], fr[707, 1000]] == pytest.approx([106.0, 154.8, 50.7, 53.8], abs=0.05)

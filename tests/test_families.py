@@ -1066,15 +1066,28 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
 
 
-def _assert_diagnostic_differs_only_in(diag_path: Path, field: str, diag_value: float, base_value: float) -> None:
-    """A rotary diagnostic case ``<family case>_<suffix>`` differs from its family case (cases/rotary/reduced) in the
-    name and in ``specimen.<field>`` only (``diag_value`` there, ``base_value`` in the family case)."""
+def _diagnostic_changes(diag_path: Path) -> dict:
+    """The fields in which a rotary diagnostic case ``<family case>_<suffix>`` differs from its family case
+    (cases/rotary/reduced), name aside: ``{(section, field): (diagnostic value, family value)}``."""
     import yaml
 
     diag = yaml.safe_load(diag_path.read_text())
     base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"{diag['name'].rsplit('_', 1)[0]}.yaml").read_text())
-    assert diag["specimen"].pop(field) == diag_value and base["specimen"].pop(field) == base_value
-    assert {**diag, "name": base["name"]} == base
+    assert diag.keys() == base.keys()
+    changes = {}
+    for section in diag.keys() - {"name"}:
+        a, b = diag[section], base[section]
+        if not isinstance(a, dict):
+            assert a == b, section
+            continue
+        changes.update({(section, k): (a.get(k), b.get(k)) for k in a.keys() | b.keys() if a.get(k) != b.get(k)})
+    return changes
+
+
+def _assert_diagnostic_differs_only_in(diag_path: Path, field: str, diag_value: float, base_value: float) -> None:
+    """A rotary diagnostic case differs from its family case in the name and in ``specimen.<field>`` only
+    (``diag_value`` there, ``base_value`` in the family case)."""
+    assert _diagnostic_changes(diag_path) == {("specimen", field): (diag_value, base_value)}
 
 
 def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit():
@@ -1119,6 +1132,59 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
                      old.loc[old["rotary_radius_full_mm"] == 250, fn].mean()]
     assert halves["0.3_0.65"] == pytest.approx([100.2, 79.7], abs=0.05)
     assert halves["0.65_1.0"] == pytest.approx([150.3, 83.2], abs=0.05)
+
+
+def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp_path):
+    """docs/families_runs/rotary_tip4 (session 29): the 66 mm block diagnostics with the tip four times as wide (6.25 mm,
+    hub 12.2 mm), so p/T is the seed's and the groove offset 0.40 tip widths at r 250 mm. Same grains as the narrow-tip
+    runs. Packing 202 turns the r 250 mm deficit round (F_n x1.14, F_r x1.19 of r 1000 mm's), 303 and 404 keep it
+    (0.46, 0.56; F_r 0.46, 0.54); over the six runs F_r rises +49 % (p 0.13), F_r/F_n is flat. The forces grow with the
+    tip (x2.0-x4.5) and climb along the travel, most at r 1000 mm near the fixed end face."""
+    import importlib.util
+    import json
+
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "rotary_tip4"
+    table = pd.read_csv(rec / "report" / "family_table.csv")
+    names = [f"rot_red_r{r}_k{k}_tip4" for r in (250, 1000) for k in (202, 303, 404)]
+    assert sorted(table["variant_case"]) == sorted(names) and table["run_completed"].all()
+    for name in names:
+        assert _diagnostic_changes(rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml") == {
+            ("specimen", "width_mm"): (66, 42), ("cutter", "tip_width_mm"): (6.25, 1.5625),
+            ("cutter", "hub_width_mm"): (12.2, 7.5)}
+    spec = importlib.util.spec_from_file_location("tip4_compare", rec / "compare.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    t = mod.paired()
+    # the same grains as the narrow-tip runs (paired() refuses otherwise); packing 404 has no narrow r 1000 mm run
+    assert t["F_n N narrow"].isna().sum() == 1 and np.isnan(t.loc[(404, 1000), "F_n N narrow"])
+    assert t.loc[(202, 250), ["F_n N narrow", "F_n N tip4", "F_r N tip4", "F_s N tip4"]].to_list() == pytest.approx(
+        [114.2, 508.0, 204.0, -23.3], abs=0.05)
+    assert t.loc[(303, 1000), ["F_n N narrow", "F_n N tip4", "F_r N tip4", "F_s N tip4"]].to_list() == pytest.approx(
+        [158.0, 624.1, 257.8, -42.5], abs=0.05)
+    assert t.loc[(slice(None), 1000), "F_n N tip4/narrow"].dropna().to_list() == pytest.approx([3.085, 3.950], abs=1e-3)
+    assert (t.loc[(slice(None), 250), "F_s N tip4"] < 0).all()
+    ratios = mod.radius_ratios(t).set_index(["packing_seed", "tip"])
+    assert ratios.loc[(202, "narrow"), ["F_n r250/r1000", "F_r r250/r1000"]].to_list() == pytest.approx([0.790, 0.790], abs=1e-3)
+    assert ratios["F_r r250/r1000"].xs("tip4", level="tip").to_list() == pytest.approx([1.194, 0.459, 0.541], abs=1e-3)
+    assert ratios["F_n r250/r1000"].xs("tip4", level="tip").to_list() == pytest.approx([1.138, 0.462, 0.561], abs=1e-3)
+    _assert_trend_rows(_refit_recorded("rotary", rec / "report", tmp_path), {
+        "fn_rises_with_r": (0.472, -0.128, 1.640, 0.111), "fr_falls_with_r": (0.487, -0.158, 1.829, 0.126),
+        "fr_fn_falls_with_r": (-0.0005, -0.123, 0.139, 0.992)})
+    early = pd.read_csv(rec / "window_0.3_0.65" / "family_table.csv").set_index(["packing_seed", "rotary_radius_full_mm"])
+    fr = early["force_rolling_N_mean_steady"]
+    assert [fr[k, 250] / fr[k, 1000] for k in (202, 303, 404)] == pytest.approx([1.265, 0.362, 0.996], abs=1e-3)
+    # travel_bins: the mean of F_n over fractions of the travel, on a made-up parsed folder (F_n = 1000 N x fraction)
+    run = tmp_path / "parsed"
+    run.mkdir()
+    (run / "summary.json").write_text(json.dumps({"case": "made_up", "cut_duration_s": 2.0}))
+    time = np.linspace(0.0, 2.0, 2001)
+    pd.DataFrame({"time_s": time, "force_normal_N": 500.0 * time}).to_csv(run / "timeseries.csv", index=False)
+    bins = mod.travel_bins([run]).iloc[0]
+    assert bins["case"] == "made_up"
+    assert [bins[f"F_n N {a:g}-{b:g}"] for a, b in mod.TRAVEL_BINS] == pytest.approx(
+        [1000 * (a + b) / 2 for a, b in mod.TRAVEL_BINS], abs=0.6)
 
 
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():

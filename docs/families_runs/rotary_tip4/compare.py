@@ -1,0 +1,90 @@
+"""The disc tip four times as wide against the family tip, on the same grains (session 29).
+
+Reads the tip4 report (report/family_table.csv: the diagnostic runs as variants of the family cases) and the
+session-28 66 mm block report (../rotary_wide66/report/family_table.csv). The tip4 cases are the wide66 cases with the
+tip 6.25 mm instead of 1.5625 mm (hub 12.2 mm instead of 7.5 mm) and nothing else: the packing seed and the block are
+the same, so the grains and bonds are identical and each tip4 run pairs with the wide66 run of the same packing and r.
+
+Prints one row per (packing, r) with F_n, F_r, F_s and F_r/F_n for both tips and the tip4/narrow ratio, and one row per
+packing and tip with r 250 mm over r 1000 mm of F_n, F_r and abs(F_s): the ratio the groove offset is tested on (it is
+1.60 tip widths at r 250 mm with the family tip and 0.40 with tip4, as at full scale).
+
+    python docs/families_runs/rotary_tip4/compare.py
+    python docs/families_runs/rotary_tip4/compare.py --bins <parsed folder> ...   # F_n along the travel, per run
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+COLUMNS = {"F_n N": "force_normal_N_mean_steady", "F_r N": "force_rolling_N_mean_steady",
+           "F_s N": "force_side_N_mean_steady", "F_r/F_n": "rolling_to_normal_ratio_1"}
+KEYS = ["packing_seed", "rotary_radius_full_mm"]
+#: fractions of the travel: the run-in, then the steady window 0.3-1.0 in four equal bins
+TRAVEL_BINS = ((0.1, 0.3), (0.3, 0.475), (0.475, 0.65), (0.65, 0.825), (0.825, 1.0))
+
+
+def paired(tip4_csv: Path = HERE / "report" / "family_table.csv",
+           narrow_csv: Path = HERE.parent / "rotary_wide66" / "report" / "family_table.csv") -> pd.DataFrame:
+    """One row per tip4 run (packing, r): each quantity for the family tip (``narrow``; NaN where the 66 mm block has no
+    narrow-tip run of that packing and r: packing 404 at r 1000 mm), tip4 and their ratio (``tip4/narrow``)."""
+    tip4 = pd.read_csv(tip4_csv).set_index(KEYS)
+    narrow = pd.read_csv(narrow_csv).set_index(KEYS).reindex(tip4.index)
+    ran = narrow["n_grains"].notna()
+    if (tip4.loc[ran, "n_grains"] != narrow.loc[ran, "n_grains"]).any() or \
+            (tip4.loc[ran, "n_bonds_initial"] != narrow.loc[ran, "n_bonds_initial"]).any():
+        raise ValueError("the tip4 and wide66 runs of a packing must share their grains and bonds")
+    out = pd.DataFrame(index=tip4.index)
+    for name, col in COLUMNS.items():
+        out[f"{name} narrow"], out[f"{name} tip4"] = narrow[col], tip4[col]
+        out[f"{name} tip4/narrow"] = tip4[col] / narrow[col]
+    out["wall_s narrow"], out["wall_s tip4"] = narrow["wall_s"], tip4["wall_s"]
+    return out.sort_index()
+
+
+def radius_ratios(table: pd.DataFrame | None = None) -> pd.DataFrame:
+    """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (the packings run at both radii)."""
+    t = paired() if table is None else table
+    rows = []
+    for seed in sorted(t.index.get_level_values(0).unique()):
+        if (seed, 250) not in t.index or (seed, 1000) not in t.index:
+            continue
+        for tip in ("narrow", "tip4"):
+            row = {"packing_seed": seed, "tip": tip}
+            if t.loc[[(seed, 250), (seed, 1000)], f"F_n N {tip}"].isna().any():
+                continue
+            for name in ("F_n N", "F_r N", "F_s N"):
+                a, b = t.loc[(seed, 250), f"{name} {tip}"], t.loc[(seed, 1000), f"{name} {tip}"]
+                key = "abs(F_s)" if name == "F_s N" else name.split()[0]
+                row[f"{key} r250/r1000"] = abs(a) / abs(b) if name == "F_s N" else a / b
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def travel_bins(parsed: list[Path]) -> pd.DataFrame:
+    """Mean F_n (N) of each parsed run folder (``deckgen parse`` output: timeseries.csv, summary.json) over the
+    fractions of the travel in :data:`TRAVEL_BINS`, one row per run."""
+    rows = []
+    for p in map(Path, parsed):
+        s = json.loads((p / "summary.json").read_text())
+        ts = pd.read_csv(p / "timeseries.csv", usecols=["time_s", "force_normal_N"])
+        f = ts["time_s"] / s["cut_duration_s"]
+        rows.append({"case": s["case"], **{f"F_n N {a:g}-{b:g}": ts.loc[(f > a) & (f <= b), "force_normal_N"].mean()
+                                          for a, b in TRAVEL_BINS}})
+    return pd.DataFrame(rows)
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] == ["--bins"]:
+        with pd.option_context("display.width", 220, "display.max_columns", 30):
+            print(travel_bins(sys.argv[2:]).round(1).to_string(index=False))
+        sys.exit(0)
+    with pd.option_context("display.width", 220, "display.max_columns", 30):
+        t = paired()
+        print(t.round(3).to_string())
+        print()
+        print(radius_ratios(t).round(3).to_string(index=False))

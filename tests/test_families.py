@@ -937,14 +937,11 @@ def test_trend_intervals_of_the_recorded_reports():
     change. It regenerates from the recorded family tables, the re-fitted slopes equal the recorded ones, and the
     documented readings hold: the linear F_r/F_n rise holds the seed's +93 % (bpm granite, 24 runs), the ODC nu < 1
     fall the seed's -30 % (smooth cone), while the rotary F_r/F_n on 3 and 5 packings excludes the seed's -47 %."""
-    import importlib.util
 
     import pandas as pd
 
     path = ROOT / "docs" / "families_runs" / "trend_intervals.py"
-    spec = importlib.util.spec_from_file_location("trend_intervals", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _docs_script(path)
     fresh = mod.intervals()
     recorded = pd.read_csv(path.with_suffix(".csv"))
     assert list(fresh["report"] + "/" + fresh["trend"]) == list(recorded["report"] + "/" + recorded["trend"])
@@ -990,15 +987,12 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
     path: checked against the golden tiny_rotary deck's variables (start xc0, axis (ax_x, ax_y), r_rot, yaw_rate), and
     on the family's reduced cases it gives the gaps to the fixed xmax grains quoted in docs/families.md (6.9 / 3.1 / 2.2
     / 1.9 mm at the end of the travel for r 250 / 500 / 1000 / 3000 mm)."""
-    import importlib.util
 
     import yaml
 
     from deckgen.spec import load_case
 
-    spec = importlib.util.spec_from_file_location("rotary_fixed_face", ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
-    geo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(geo)
+    geo = _docs_script(ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
     case_path = ROOT / "tests" / "data" / "cases" / "tiny_rotary.yaml"
     case, k = load_case(case_path), yaml.safe_load(case_path.read_text())["kinematics"]
     deck = (ROOT / "tests" / "data" / "golden" / "tiny_rotary" / "in.deck").read_text()
@@ -1066,6 +1060,16 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
 
 
+def _docs_script(path: Path):
+    """Import a script under docs/families_runs (not a package) as a module."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
 def _diagnostic_changes(diag_path: Path) -> dict:
     """The fields in which a rotary diagnostic case ``<family case>_<suffix>`` differs from its family case
     (cases/rotary/reduced), name aside: ``{(section, field): (diagnostic value, family value)}``."""
@@ -1095,7 +1099,6 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
     the r 250 mm travel 16.8 mm from the free side face instead of 4.8 mm. Four packings at r 250 mm average F_n 125.3 N
     (42 mm block, seven packings: 100.5 N; r >= 500 mm there 176-188 N), Welch p 0.25; F_r 50.6 N against 45.8 N
     (p 0.59). On the two packings also run at r 1000 mm F_n still rises (x1.27, x1.22) and F_r with it (x1.27, x2.27)."""
-    import importlib.util
 
     import pandas as pd
 
@@ -1106,9 +1109,7 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
     assert table["run_completed"].all() and table["n_grains"].between(4129, 4165).all()
     for name in table["variant_case"]:
         _assert_diagnostic_differs_only_in(rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml", "width_mm", 66, 42)
-    spec = importlib.util.spec_from_file_location("wide_compare", rec / "compare.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _docs_script(rec / "compare.py")
     c = mod.compare().set_index("quantity")
     assert c.loc["F_n N", ["wide_r250_mean", "narrow_r250_mean", "welch_p"]].to_list() == pytest.approx(
         [125.26, 100.46, 0.250], abs=5e-3)
@@ -1140,7 +1141,6 @@ def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp
     runs. Packing 202 turns the r 250 mm deficit round (F_n x1.14, F_r x1.19 of r 1000 mm's), 303 and 404 keep it
     (0.46, 0.56; F_r 0.46, 0.54); over the six runs F_r rises +49 % (p 0.13), F_r/F_n is flat. The forces grow with the
     tip (x2.0-x4.5) and climb along the travel, most at r 1000 mm near the fixed end face."""
-    import importlib.util
     import json
 
     import pandas as pd
@@ -1153,9 +1153,7 @@ def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp
         assert _diagnostic_changes(rec / f"diagnostic_{name.removeprefix('rot_red_')}.yaml") == {
             ("specimen", "width_mm"): (66, 42), ("cutter", "tip_width_mm"): (6.25, 1.5625),
             ("cutter", "hub_width_mm"): (12.2, 7.5)}
-    spec = importlib.util.spec_from_file_location("tip4_compare", rec / "compare.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _docs_script(rec / "compare.py")
     t = mod.paired()
     # the same grains as the narrow-tip runs (paired() refuses otherwise); packing 404 has no narrow r 1000 mm run
     assert t["F_n N narrow"].isna().sum() == 1 and np.isnan(t.loc[(404, 1000), "F_n N narrow"])
@@ -1185,6 +1183,25 @@ def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp
     assert bins["case"] == "made_up"
     assert [bins[f"F_n N {a:g}-{b:g}"] for a, b in mod.TRAVEL_BINS] == pytest.approx(
         [1000 * (a + b) / 2 for a, b in mod.TRAVEL_BINS], abs=0.6)
+
+
+def test_tip4_block40_cases_keep_the_chord_front_away_from_the_fixed_end_face():
+    """docs/families_runs/rotary_tip4_block40 (written in session 29, not run yet): the tip4 cases on a 40 mm block, where
+    the chord front ends the travel 20.9 / 16.2 mm from the fixed xmax grains at r 250 / 1000 mm (26 mm block: 6.9 /
+    2.2 mm) and 16.8 mm from the free side at r 250 mm; the groove offset stays 0.40 / 0.10 tip widths."""
+    geo = _docs_script(ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
+    rec = ROOT / "docs" / "families_runs" / "rotary_tip4_block40"
+    for (r, k), (gap_fixed, gap_side, offset_tips) in {(250, 202): (20.9, 16.8, 0.40), (250, 303): (20.9, 16.8, 0.40),
+                                                       (1000, 202): (16.2, 28.7, 0.10), (1000, 303): (16.2, 28.7, 0.10)}.items():
+        path = rec / f"diagnostic_r{r}_k{k}_tip4b40.yaml"
+        assert _diagnostic_changes(path) == {
+            ("specimen", "length_mm"): (40, 26), ("specimen", "width_mm"): (66, 42),
+            ("cutter", "tip_width_mm"): (6.25, 1.5625), ("cutter", "hub_width_mm"): (12.2, 7.5)}
+        case = load_case(path)
+        x, y, _ = geo.front_path(case, 1.0)
+        assert [case.specimen.length_mm - geo.FIXED_SLAB_MM - x, case.specimen.width_mm / 2 - y] == pytest.approx(
+            [gap_fixed, gap_side], abs=0.05)
+        assert geo.groove_offset_mm(case) / case.cutter.tip_width_mm == pytest.approx(offset_tips, abs=0.005)
 
 
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():

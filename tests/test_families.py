@@ -937,7 +937,6 @@ def test_trend_intervals_of_the_recorded_reports():
     change. It regenerates from the recorded family tables, the re-fitted slopes equal the recorded ones, and the
     documented readings hold: the linear F_r/F_n rise holds the seed's +93 % (bpm granite, 24 runs), the ODC nu < 1
     fall the seed's -30 % (smooth cone), while the rotary F_r/F_n on 3 and 5 packings excludes the seed's -47 %."""
-
     import pandas as pd
 
     path = ROOT / "docs" / "families_runs" / "trend_intervals.py"
@@ -987,7 +986,6 @@ def test_rotary_fixed_face_geometry_follows_the_deck_path():
     path: checked against the golden tiny_rotary deck's variables (start xc0, axis (ax_x, ax_y), r_rot, yaw_rate), and
     on the family's reduced cases it gives the gaps to the fixed xmax grains quoted in docs/families.md (6.9 / 3.1 / 2.2
     / 1.9 mm at the end of the travel for r 250 / 500 / 1000 / 3000 mm)."""
-
     import yaml
 
     from deckgen.spec import load_case
@@ -1099,7 +1097,6 @@ def test_recorded_rotary_wide_block_diagnostic_leaves_most_of_the_r250_deficit()
     the r 250 mm travel 16.8 mm from the free side face instead of 4.8 mm. Four packings at r 250 mm average F_n 125.3 N
     (42 mm block, seven packings: 100.5 N; r >= 500 mm there 176-188 N), Welch p 0.25; F_r 50.6 N against 45.8 N
     (p 0.59). On the two packings also run at r 1000 mm F_n still rises (x1.27, x1.22) and F_r with it (x1.27, x2.27)."""
-
     import pandas as pd
 
     rec = ROOT / "docs" / "families_runs" / "rotary_wide66"

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from deckgen.results import steady_mask
+
 HERE = Path(__file__).resolve().parent
 COLUMNS = {"F_n N": "force_normal_N_mean_steady", "F_r N": "force_rolling_N_mean_steady",
            "F_s N": "force_side_N_mean_steady", "F_r/F_n": "rolling_to_normal_ratio_1"}
@@ -47,34 +49,34 @@ def paired(tip4_csv: Path = HERE / "report" / "family_table.csv",
 
 
 def radius_ratios(table: pd.DataFrame | None = None) -> pd.DataFrame:
-    """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (the packings run at both radii)."""
+    """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (where that tip ran at both radii)."""
     t = paired() if table is None else table
     rows = []
     for seed in sorted(t.index.get_level_values(0).unique()):
-        if (seed, 250) not in t.index or (seed, 1000) not in t.index:
-            continue
         for tip in ("narrow", "tip4"):
-            row = {"packing_seed": seed, "tip": tip}
-            if t.loc[[(seed, 250), (seed, 1000)], f"F_n N {tip}"].isna().any():
+            try:
+                at250, at1000 = t.loc[(seed, 250)], t.loc[(seed, 1000)]
+            except KeyError:
                 continue
-            for name in ("F_n N", "F_r N", "F_s N"):
-                a, b = t.loc[(seed, 250), f"{name} {tip}"], t.loc[(seed, 1000), f"{name} {tip}"]
-                key = "abs(F_s)" if name == "F_s N" else name.split()[0]
-                row[f"{key} r250/r1000"] = abs(a) / abs(b) if name == "F_s N" else a / b
-            rows.append(row)
+            if pd.isna([at250[f"F_n N {tip}"], at1000[f"F_n N {tip}"]]).any():
+                continue
+            rows.append({"packing_seed": seed, "tip": tip,
+                         "F_n r250/r1000": at250[f"F_n N {tip}"] / at1000[f"F_n N {tip}"],
+                         "F_r r250/r1000": at250[f"F_r N {tip}"] / at1000[f"F_r N {tip}"],
+                         "abs(F_s) r250/r1000": abs(at250[f"F_s N {tip}"] / at1000[f"F_s N {tip}"])})
     return pd.DataFrame(rows)
 
 
 def travel_bins(parsed: list[Path]) -> pd.DataFrame:
     """Mean F_n (N) of each parsed run folder (``deckgen parse`` output: timeseries.csv, summary.json) over the
-    fractions of the travel in :data:`TRAVEL_BINS`, one row per run."""
+    fractions of the travel in :data:`TRAVEL_BINS` (each as a steady window of ``deckgen parse``), one row per run."""
     rows = []
     for p in map(Path, parsed):
         s = json.loads((p / "summary.json").read_text())
         ts = pd.read_csv(p / "timeseries.csv", usecols=["time_s", "force_normal_N"])
-        f = ts["time_s"] / s["cut_duration_s"]
-        rows.append({"case": s["case"], **{f"F_n N {a:g}-{b:g}": ts.loc[(f > a) & (f <= b), "force_normal_N"].mean()
-                                          for a, b in TRAVEL_BINS}})
+        rows.append({"case": s["case"], **{
+            f"F_n N {a:g}-{b:g}": ts.loc[steady_mask(ts["time_s"], s["cut_duration_s"], (a, b)), "force_normal_N"].mean()
+            for a, b in TRAVEL_BINS}})
     return pd.DataFrame(rows)
 
 

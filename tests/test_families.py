@@ -1183,13 +1183,13 @@ def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp
 
 
 def test_tip4_block40_cases_keep_the_chord_front_away_from_the_fixed_end_face():
-    """docs/families_runs/rotary_tip4_block40 (written in session 29, not run yet): the tip4 cases on a 40 mm block, where
+    """docs/families_runs/rotary_tip4_block40 (sessions 29-30): the tip4 cases on a 40 mm block, packings 202/303/404, where
     the chord front ends the travel 20.9 / 16.2 mm from the fixed xmax grains at r 250 / 1000 mm (26 mm block: 6.9 /
     2.2 mm) and 16.8 mm from the free side at r 250 mm; the groove offset stays 0.40 / 0.10 tip widths."""
     geo = _docs_script(ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
     rec = ROOT / "docs" / "families_runs" / "rotary_tip4_block40"
-    for (r, k), (gap_fixed, gap_side, offset_tips) in {(250, 202): (20.9, 16.8, 0.40), (250, 303): (20.9, 16.8, 0.40),
-                                                       (1000, 202): (16.2, 28.7, 0.10), (1000, 303): (16.2, 28.7, 0.10)}.items():
+    for (r, k), (gap_fixed, gap_side, offset_tips) in {
+            (r, k): (20.9, 16.8, 0.40) if r == 250 else (16.2, 28.7, 0.10) for r in (250, 1000) for k in (202, 303, 404)}.items():
         path = rec / f"diagnostic_r{r}_k{k}_tip4b40.yaml"
         assert _diagnostic_changes(path) == {
             ("specimen", "length_mm"): (40, 26), ("specimen", "width_mm"): (66, 42),

@@ -11,6 +11,7 @@ packing and tip with r 250 mm over r 1000 mm of F_n, F_r and abs(F_s): the ratio
 
     python docs/families_runs/rotary_tip4/compare.py
     python docs/families_runs/rotary_tip4/compare.py --bins <parsed folder> ...   # F_n along the travel, per run
+    python docs/families_runs/rotary_tip4/compare.py --block40   # the same ratios for tip4 on the 40 mm block
 """
 from __future__ import annotations
 
@@ -28,6 +29,8 @@ COLUMNS = {"F_n N": "force_normal_N_mean_steady", "F_r N": "force_rolling_N_mean
 KEYS = ["packing_seed", "rotary_radius_full_mm"]
 #: fractions of the travel: the run-in, then the steady window 0.3-1.0 in four equal bins
 TRAVEL_BINS = ((0.1, 0.3), (0.3, 0.475), (0.475, 0.65), (0.65, 0.825), (0.825, 1.0))
+#: the tip4 runs on the 40 mm block (session 30): new packings of the same seeds, so no pairing with the 26 mm block runs
+BLOCK40 = HERE.parent / "rotary_tip4_block40" / "report" / "family_table.csv"
 
 
 def paired(tip4_csv: Path = HERE / "report" / "family_table.csv",
@@ -48,12 +51,19 @@ def paired(tip4_csv: Path = HERE / "report" / "family_table.csv",
     return out.sort_index()
 
 
-def radius_ratios(table: pd.DataFrame | None = None) -> pd.DataFrame:
+def report_forces(csv: Path, label: str) -> pd.DataFrame:
+    """The forces of one report (family_table.csv) as columns ``<quantity> <label>``, indexed by (packing, r): the
+    form :func:`radius_ratios` reads, for a report with no narrow-tip twin (the 40 mm block, ``../rotary_tip4_block40``)."""
+    t = pd.read_csv(csv).set_index(KEYS).sort_index()
+    return pd.DataFrame({f"{name} {label}": t[col] for name, col in COLUMNS.items()} | {f"wall_s {label}": t["wall_s"]})
+
+
+def radius_ratios(table: pd.DataFrame | None = None, tips: tuple[str, ...] = ("narrow", "tip4")) -> pd.DataFrame:
     """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (where that tip ran at both radii)."""
     t = paired() if table is None else table
     rows = []
     for seed in sorted(t.index.get_level_values(0).unique()):
-        for tip in ("narrow", "tip4"):
+        for tip in tips:
             try:
                 at250, at1000 = t.loc[(seed, 250)], t.loc[(seed, 1000)]
             except KeyError:
@@ -81,12 +91,16 @@ def travel_bins(parsed: list[Path]) -> pd.DataFrame:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--bins"]:
-        with pd.option_context("display.width", 220, "display.max_columns", 30):
-            print(travel_bins(sys.argv[2:]).round(1).to_string(index=False))
-        sys.exit(0)
     with pd.option_context("display.width", 220, "display.max_columns", 30):
-        t = paired()
-        print(t.round(3).to_string())
-        print()
-        print(radius_ratios(t).round(3).to_string(index=False))
+        if sys.argv[1:2] == ["--bins"]:
+            print(travel_bins(sys.argv[2:]).round(1).to_string(index=False))
+        elif sys.argv[1:2] == ["--block40"]:
+            t = report_forces(BLOCK40, "tip4b40")
+            print(t.round(3).to_string())
+            print()
+            print(radius_ratios(t, ("tip4b40",)).round(3).to_string(index=False))
+        else:
+            t = paired()
+            print(t.round(3).to_string())
+            print()
+            print(radius_ratios(t).round(3).to_string(index=False))

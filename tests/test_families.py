@@ -1175,11 +1175,16 @@ def test_recorded_rotary_tip4_diagnostic_leaves_the_groove_offset_unresolved(tmp
     run.mkdir()
     (run / "summary.json").write_text(json.dumps({"case": "made_up", "cut_duration_s": 2.0}))
     time = np.linspace(0.0, 2.0, 2001)
-    pd.DataFrame({"time_s": time, "force_normal_N": 500.0 * time}).to_csv(run / "timeseries.csv", index=False)
+    pd.DataFrame({"time_s": time, "force_normal_N": 500.0 * time, "force_rolling_N": 100.0 + 0.0 * time,
+                  "cutter_advance_m": 0.01 * time}).to_csv(run / "timeseries.csv", index=False)
     bins = mod.travel_bins([run]).iloc[0]
     assert bins["case"] == "made_up"
     assert [bins[f"F_n N {a:g}-{b:g}"] for a, b in mod.TRAVEL_BINS] == pytest.approx(
         [1000 * (a + b) / 2 for a, b in mod.TRAVEL_BINS], abs=0.6)
+    # a constant F_r has no error; a ramp is one slow swing, correlated over much of the window: about 3 independent
+    # samples in its 14 mm (0.3-1.0 of 20 mm of travel)
+    assert bins["F_r N sem/mean"] == 0.0 and 2.5 < bins["n_eff"] < 3.5
+    assert bins["tau mm"] == pytest.approx(14.0 / bins["n_eff"], rel=0.01)
 
 
 def test_tip4_block40_cases_keep_the_chord_front_away_from_the_fixed_end_face():

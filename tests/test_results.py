@@ -644,3 +644,27 @@ def test_split_map_marks_the_bonds_broken_by_the_split(tmp_path):
     old = {k: v for k, v in s.items() if k not in ("split_step", "split_band_x_m", "split_band_z_m")}
     assert _split_map(old, ts, broken, tmp_path / "old.png") is not None  # a summary from before those keys
     assert _split_map(s, ts, broken.iloc[0:0], tmp_path / "none.png") is None
+
+
+def test_mean_standard_error_follows_the_autocorrelation_time():
+    """deckgen.results.mean_standard_error on series with a known integrated autocorrelation time: white noise (tau 1)
+    and AR(1) x_i = phi x_(i-1) + e_i, whose tau is (1 + phi) / (1 - phi) (19 at phi 0.9), so its mean's standard
+    error is sqrt(tau) times std / sqrt(n). Too short or constant series give NaN / 0."""
+    from deckgen.results import mean_standard_error
+
+    rng = np.random.default_rng(7)
+    n = 200_000
+    white = mean_standard_error(rng.normal(5.0, 2.0, n))
+    assert white["tau_rows"] == pytest.approx(1.0, abs=0.05)
+    assert white["sem"] == pytest.approx(2.0 / np.sqrt(n), rel=0.05)
+    phi, e = 0.9, rng.normal(0.0, 1.0, n)
+    x = np.empty(n)
+    x[0] = 0.0
+    for i in range(1, n):
+        x[i] = phi * x[i - 1] + e[i]
+    ar = mean_standard_error(x)
+    assert ar["tau_rows"] == pytest.approx(19.0, rel=0.1)
+    assert ar["n_eff"] == pytest.approx(n / 19.0, rel=0.1)
+    assert ar["sem"] == pytest.approx(np.sqrt(19.0) * x.std(ddof=1) / np.sqrt(n), rel=0.06)
+    assert np.isnan(mean_standard_error([1.0, 2.0])["sem"])
+    assert mean_standard_error(np.full(10, 3.0))["sem"] == 0.0

@@ -818,7 +818,8 @@ EXTRA_PLOTS: dict[str, list[tuple[str, list[str], list[str]]]] = {
 TABLE_FIELDS = [
     "n_grains", "n_bonds_initial", "steps", "dt_s", "wall_s", "particle_steps_per_s", "run_completed",
     "force_normal_N_mean_steady", "force_rolling_N_mean_steady", "force_side_N_mean_steady",
-    "force_magnitude_N_mean_steady", "force_magnitude_N_mean_cycles", "force_magnitude_N_mean_cycles_sliding",
+    "force_magnitude_N_mean_steady", "force_normal_N_sem_steady", "force_rolling_N_sem_steady",
+    "force_side_N_sem_steady", "force_magnitude_N_sem_steady", "force_magnitude_N_mean_cycles", "force_magnitude_N_mean_cycles_sliding",
     "cycles_averaged_1", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",

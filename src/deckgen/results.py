@@ -103,7 +103,7 @@ UNITLESS_COLUMNS = frozenset({
 UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m3", "_J_m3", "_m_s",
                  "_rad_s", "_per_s")
 #: Statistic suffixes after the unit (``force_normal_N_mean_steady``).
-STAT_SUFFIXES = ("_mean_steady", "_mean_cycles", "_mean_cycles_sliding", "_peak")
+STAT_SUFFIXES = ("_mean_steady", "_sem_steady", "_mean_cycles", "_mean_cycles_sliding", "_peak")
 
 
 def has_unit(name: str) -> bool:
@@ -130,7 +130,7 @@ BROKEN_TS_COLUMNS = ["time_s", "step", "bonds_broken", "bonds_broken_tension",
 DAMAGE_COLUMNS = ["id", "radius_m", "x_m", "y_m", "z_m", "bonds_initial", "bonds_final",
                   "damage_ratio_1"]
 
-#: Cutter-frame quantities summarised for cutting runs (``<name>_mean_steady``, ``<name>_peak``).
+#: Cutter-frame quantities summarised for cutting runs (``<name>_mean_steady``, ``<name>_sem_steady``, ``<name>_peak``).
 CUTTING_QUANTITIES = ["force_normal_N", "force_rolling_N", "force_side_N", "torque_axis_Nm",
                       "force_magnitude_N"]
 
@@ -339,6 +339,30 @@ def steady_mask(time_s: np.ndarray | pd.Series, duration_s: float,
     a, b = float(window[0]), float(window[1])
     t = np.asarray(time_s, dtype=float)
     return (t >= a * duration_s) & (t <= b * duration_s)
+
+
+def mean_standard_error(values: np.ndarray | pd.Series) -> dict[str, float]:
+    """Standard error of the mean of a correlated series (a force over the steady window), from its integrated
+    autocorrelation time: ``tau = 1 + 2 * sum(acf[1:k])`` with the sum cut at the first lag ``k`` where the sample
+    autocorrelation (statsmodels ``acf``, FFT) falls below zero; ``n_eff = n / tau`` and ``sem = std / sqrt(n_eff)``.
+
+    A cutting force rises and drops with the chips, so neighbouring rows are far from independent: ``std / sqrt(n)``
+    would understate the error by ``sqrt(tau)``. Cutting the sum at the first zero is the simple window (it
+    underestimates ``tau`` a little for slowly decaying correlation; with few chips in the window the estimate itself
+    is rough). Returns ``sem``, ``tau_rows`` (tau in rows) and ``n_eff``; NaN for fewer than 3 finite values."""
+    from statsmodels.tsa.stattools import acf
+
+    x = np.asarray(values, dtype=float)
+    x = x[np.isfinite(x)]
+    if len(x) < 3 or np.all(x == x[0]):
+        nan = float("nan")
+        return {"sem": nan if len(x) < 3 else 0.0, "tau_rows": nan, "n_eff": nan if len(x) < 3 else float(len(x))}
+    rho = acf(x, nlags=len(x) - 1, fft=True)
+    below = np.flatnonzero(rho < 0)
+    k = int(below[0]) if len(below) else len(rho)
+    tau = max(1.0, 1.0 + 2.0 * float(rho[1:k].sum()))
+    n_eff = len(x) / tau
+    return {"sem": float(x.std(ddof=1) / math.sqrt(n_eff)), "tau_rows": tau, "n_eff": n_eff}
 
 
 # ----------------------------------------------------------------------------- timeseries
@@ -810,6 +834,8 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
     for q in CUTTING_QUANTITIES:
         v = ts[q].to_numpy()
         out[f"{q}_mean_steady"] = float(v[mask].mean()) if mask.any() else _nan()
+        # its standard error: the chips correlate the rows, so from the integrated autocorrelation time
+        out[f"{q}_sem_steady"] = mean_standard_error(v[mask])["sem"]
         out[f"{q}_peak"] = float(v[int(np.argmax(np.abs(v)))]) if len(v) else _nan()
     # oscillating cuts: means over the whole cycles that fit in the steady window from its start (a mean over
     # 1.4 cycles weights the phase that is in the window twice); no whole cycle: NaN; no oscillation: the
@@ -902,7 +928,8 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
 
     Cutting adds, for q in force_normal_N, force_rolling_N, force_side_N, torque_axis_Nm,
     force_magnitude_N: ``q_mean_steady`` (mean over rows with a*T <= time_s <= b*T, [a, b] the
-    steady window, T = derived.cutter.duration) and ``q_peak`` (the value of largest magnitude
+    steady window, T = derived.cutter.duration), ``q_sem_steady`` (the standard error of that mean from the series'
+    integrated autocorrelation time, :func:`mean_standard_error`) and ``q_peak`` (the value of largest magnitude
     over the whole run, with its sign); ``q_mean_cycles`` (oscillating cuts: mean over the
     ``cycles_averaged_1`` whole cycles 2 pi / omega that fit in the steady window from its start, NaN when
     none fits; other cuts: ``q_mean_steady``); ``q_mean_cycles_sliding`` (the mean of the means of every window of

@@ -19,9 +19,10 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
-from deckgen.results import steady_mask
+from deckgen.results import mean_standard_error, steady_mask
 
 HERE = Path(__file__).resolve().parent
 COLUMNS = {"F_n N": "force_normal_N_mean_steady", "F_r N": "force_rolling_N_mean_steady",
@@ -29,6 +30,8 @@ COLUMNS = {"F_n N": "force_normal_N_mean_steady", "F_r N": "force_rolling_N_mean
 KEYS = ["packing_seed", "rotary_radius_full_mm"]
 #: fractions of the travel: the run-in, then the steady window 0.3-1.0 in four equal bins
 TRAVEL_BINS = ((0.1, 0.3), (0.3, 0.475), (0.475, 0.65), (0.65, 0.825), (0.825, 1.0))
+#: the forces :func:`travel_bins` bins (name: timeseries.csv column)
+BIN_FORCES = {"F_n N": "force_normal_N", "F_r N": "force_rolling_N"}
 #: the tip4 runs on the 40 mm block (session 30): new packings of the same seeds, so no pairing with the 26 mm block runs
 BLOCK40 = HERE.parent / "rotary_tip4_block40" / "report" / "family_table.csv"
 
@@ -55,11 +58,17 @@ def report_forces(csv: Path, label: str) -> pd.DataFrame:
     """The forces of one report (family_table.csv) as columns ``<quantity> <label>``, indexed by (packing, r): the
     form :func:`radius_ratios` reads, for a report with no narrow-tip twin (the 40 mm block, ``../rotary_tip4_block40``)."""
     t = pd.read_csv(csv).set_index(KEYS).sort_index()
-    return pd.DataFrame({f"{name} {label}": t[col] for name, col in COLUMNS.items()} | {f"wall_s {label}": t["wall_s"]})
+    out = {f"{name} {label}": t[col] for name, col in COLUMNS.items()} | {f"wall_s {label}": t["wall_s"]}
+    # the standard errors of the steady means, where the report has them (summaries parsed since session 30)
+    out |= {f"{name} sem {label}": t[col.replace("_mean_steady", "_sem_steady")] for name, col in COLUMNS.items()
+            if col.endswith("_mean_steady") and col.replace("_mean_steady", "_sem_steady") in t}
+    return pd.DataFrame(out)
 
 
 def radius_ratios(table: pd.DataFrame | None = None, tips: tuple[str, ...] = ("narrow", "tip4")) -> pd.DataFrame:
-    """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (where that tip ran at both radii)."""
+    """r 250 mm over r 1000 mm of F_n, F_r and abs(F_s), per packing and tip (where that tip ran at both radii); with
+    the standard errors of the two means (``<F> sem <tip>`` columns) also the ratio's, ``<F> r250/r1000 se``
+    (first-order propagation: ratio * sqrt(rel. error at r 250 ** 2 + rel. error at r 1000 ** 2))."""
     t = paired() if table is None else table
     rows = []
     for seed in sorted(t.index.get_level_values(0).unique()):
@@ -74,26 +83,42 @@ def radius_ratios(table: pd.DataFrame | None = None, tips: tuple[str, ...] = ("n
                          "F_n r250/r1000": at250[f"F_n N {tip}"] / at1000[f"F_n N {tip}"],
                          "F_r r250/r1000": at250[f"F_r N {tip}"] / at1000[f"F_r N {tip}"],
                          "abs(F_s) r250/r1000": abs(at250[f"F_s N {tip}"] / at1000[f"F_s N {tip}"])})
+            for f in ("F_n", "F_r"):
+                if f"{f} N sem {tip}" in t:
+                    rel = [at[f"{f} N sem {tip}"] / at[f"{f} N {tip}"] for at in (at250, at1000)]
+                    rows[-1][f"{f} r250/r1000 se"] = rows[-1][f"{f} r250/r1000"] * float(np.hypot(*rel))
     return pd.DataFrame(rows)
 
 
-def travel_bins(parsed: list[Path]) -> pd.DataFrame:
-    """Mean F_n (N) of each parsed run folder (``deckgen parse`` output: timeseries.csv, summary.json) over the
-    fractions of the travel in :data:`TRAVEL_BINS` (each as a steady window of ``deckgen parse``), one row per run."""
+def travel_bins(parsed: list[Path], window: tuple[float, float] = (0.3, 1.0)) -> pd.DataFrame:
+    """Mean F_n and F_r (N) of each parsed run folder (``deckgen parse`` output: timeseries.csv, summary.json) over the
+    fractions of the travel in :data:`TRAVEL_BINS` (each as a steady window of ``deckgen parse``), one row per run.
+
+    ``<F> sem/mean`` is the standard error of the mean over ``window`` (the steady window) relative to that mean, from
+    the series' integrated autocorrelation time (:func:`deckgen.results.mean_standard_error`); ``tau mm`` is that time
+    as travel of the cutter (F_n's), ``n_eff`` the number of independent samples it leaves in the window."""
     rows = []
     for p in map(Path, parsed):
         s = json.loads((p / "summary.json").read_text())
-        ts = pd.read_csv(p / "timeseries.csv", usecols=["time_s", "force_normal_N"])
-        rows.append({"case": s["case"], **{
-            f"F_n N {a:g}-{b:g}": ts.loc[steady_mask(ts["time_s"], s["cut_duration_s"], (a, b)), "force_normal_N"].mean()
-            for a, b in TRAVEL_BINS}})
+        ts = pd.read_csv(p / "timeseries.csv", usecols=["time_s", "cutter_advance_m", *BIN_FORCES.values()])
+        row = {"case": s["case"]}
+        steady = steady_mask(ts["time_s"], s["cut_duration_s"], window)
+        for name, col in BIN_FORCES.items():
+            row.update({f"{name} {a:g}-{b:g}": ts.loc[steady_mask(ts["time_s"], s["cut_duration_s"], (a, b)), col].mean()
+                        for a, b in TRAVEL_BINS})
+            err = mean_standard_error(ts.loc[steady, col])
+            row[f"{name} sem/mean"] = err["sem"] / ts.loc[steady, col].mean()
+            if name == "F_n N":
+                step_mm = 1e3 * float(np.median(np.diff(ts.loc[steady, "cutter_advance_m"])))
+                row["tau mm"], row["n_eff"] = err["tau_rows"] * step_mm, err["n_eff"]
+        rows.append(row)
     return pd.DataFrame(rows)
 
 
 if __name__ == "__main__":
     with pd.option_context("display.width", 220, "display.max_columns", 30):
         if sys.argv[1:2] == ["--bins"]:
-            print(travel_bins(sys.argv[2:]).round(1).to_string(index=False))
+            print(travel_bins(sys.argv[2:]).round(2).to_string(index=False))
         elif sys.argv[1:2] == ["--block40"]:
             t = report_forces(BLOCK40, "tip4b40")
             print(t.round(3).to_string())

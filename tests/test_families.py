@@ -1193,8 +1193,8 @@ def test_tip4_block40_cases_keep_the_chord_front_away_from_the_fixed_end_face():
     2.2 mm) and 16.8 mm from the free side at r 250 mm; the groove offset stays 0.40 / 0.10 tip widths."""
     geo = _docs_script(ROOT / "docs" / "families_runs" / "rotary_fixed_face.py")
     rec = ROOT / "docs" / "families_runs" / "rotary_tip4_block40"
-    for (r, k), (gap_fixed, gap_side, offset_tips) in {
-            (r, k): (20.9, 16.8, 0.40) if r == 250 else (16.2, 28.7, 0.10) for r in (250, 1000) for k in (202, 303, 404, 505)}.items():
+    at_r = {250: (20.9, 16.8, 0.40), 1000: (16.2, 28.7, 0.10)}
+    for (r, k), (gap_fixed, gap_side, offset_tips) in {(r, k): at_r[r] for r in at_r for k in (202, 303, 404, 505)}.items():
         path = rec / f"diagnostic_r{r}_k{k}_tip4b40.yaml"
         assert _diagnostic_changes(path) == {
             ("specimen", "length_mm"): (40, 26), ("specimen", "width_mm"): (66, 42),

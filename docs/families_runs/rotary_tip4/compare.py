@@ -60,8 +60,8 @@ def report_forces(csv: Path, label: str) -> pd.DataFrame:
     t = pd.read_csv(csv).set_index(KEYS).sort_index()
     out = {f"{name} {label}": t[col] for name, col in COLUMNS.items()} | {f"wall_s {label}": t["wall_s"]}
     # the standard errors of the steady means, where the report has them (summaries parsed since session 30)
-    out |= {f"{name} sem {label}": t[col.replace("_mean_steady", "_sem_steady")] for name, col in COLUMNS.items()
-            if col.endswith("_mean_steady") and col.replace("_mean_steady", "_sem_steady") in t}
+    sem = {name: col.removesuffix("_mean_steady") + "_sem_steady" for name, col in COLUMNS.items()}
+    out |= {f"{name} sem {label}": t[col] for name, col in sem.items() if col in t}
     return pd.DataFrame(out)
 
 
@@ -101,15 +101,15 @@ def travel_bins(parsed: list[Path], window: tuple[float, float] = (0.3, 1.0)) ->
     for p in map(Path, parsed):
         s = json.loads((p / "summary.json").read_text())
         ts = pd.read_csv(p / "timeseries.csv", usecols=["time_s", "cutter_advance_m", *BIN_FORCES.values()])
+        bins = {(a, b): steady_mask(ts["time_s"], s["cut_duration_s"], (a, b)) for a, b in TRAVEL_BINS}
+        steady = ts[steady_mask(ts["time_s"], s["cut_duration_s"], window)]
         row = {"case": s["case"]}
-        steady = steady_mask(ts["time_s"], s["cut_duration_s"], window)
         for name, col in BIN_FORCES.items():
-            row.update({f"{name} {a:g}-{b:g}": ts.loc[steady_mask(ts["time_s"], s["cut_duration_s"], (a, b)), col].mean()
-                        for a, b in TRAVEL_BINS})
-            err = mean_standard_error(ts.loc[steady, col])
-            row[f"{name} sem/mean"] = err["sem"] / ts.loc[steady, col].mean()
+            row.update({f"{name} {a:g}-{b:g}": ts.loc[mask, col].mean() for (a, b), mask in bins.items()})
+            err = mean_standard_error(steady[col])
+            row[f"{name} sem/mean"] = err["sem"] / steady[col].mean()
             if name == "F_n N":
-                step_mm = 1e3 * float(np.median(np.diff(ts.loc[steady, "cutter_advance_m"])))
+                step_mm = 1e3 * float(np.median(np.diff(steady["cutter_advance_m"])))
                 row["tau mm"], row["n_eff"] = err["tau_rows"] * step_mm, err["n_eff"]
         rows.append(row)
     return pd.DataFrame(rows)

@@ -688,6 +688,28 @@ def test_report_of_variants_carries_the_cutter_surface_and_friction(tmp_path):
     assert list(t["cutter_surface"]) == ["smooth"] and list(t["cutter_friction_1"]) == [0.0]
 
 
+def test_report_of_variants_carries_the_neighbour_spacing_and_block_height(tmp_path):
+    """A linear variant without neighbour grooves (an unrelieved cut) on a taller block keeps its family case's factors
+    (S 100 mm) but says what it ran: neighbour_spacing_mm NaN and its own block height; the family case itself, run as a
+    variant name, reports its grooves and height."""
+    index = str(ROOT / "cases/linear_ccs/index.csv")
+    dirs = []
+    for name, kin, height in (("lin_red_s100_p7p6_unrel_h24", {"mode": "linear", "neighbour_spacing_mm": None}, 24.0),
+                              ("lin_red_s100_p1p9_k202_same", {"mode": "linear", "neighbour_spacing_mm": 12.5}, 12.0)):
+        run = tmp_path / name
+        (run / "parsed").mkdir(parents=True)
+        case = {"name": name, "kinematics": kin, "specimen": {"kind": "cutting_block", "height_mm": height}}
+        (run / "spec.json").write_text(json.dumps({"case": case, "derived": {"n_shell": 1066}}))
+        (run / "parsed" / "summary.json").write_text(json.dumps({"case": name, "n_grains": 2488, "wall_s": 600.0}))
+        dirs.append(run / "parsed")
+    t = fam.family_table(index, dirs, variants=True).set_index("variant_case")
+    unrel, same = t.loc["lin_red_s100_p7p6_unrel_h24"], t.loc["lin_red_s100_p1p9_k202_same"]
+    assert (unrel["case"], same["case"]) == ("lin_red_s100_p7p6", "lin_red_s100_p1p9_k202")
+    assert unrel["spacing_full_mm"] == same["spacing_full_mm"] == 100
+    assert np.isnan(unrel["neighbour_spacing_mm"]) and same["neighbour_spacing_mm"] == 12.5
+    assert (unrel["block_height_mm"], same["block_height_mm"]) == (24.0, 12.0)
+
+
 def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
     index = str(ROOT / "cases/odc/index.csv")
     stray = _variant_run(tmp_path, "odc_red_s99_nospin", 1.0, 90)
@@ -874,6 +896,38 @@ def test_recorded_linear_runs_over_the_wide_window_scatter_less_with_the_same_sl
         "fr_fn_rises_with_p"]
     assert fam_fit["slope"] == pytest.approx(0.0479, abs=1e-4) and wide_fit["slope"] == pytest.approx(0.0462, abs=1e-4)
     assert fam_fit["p_value"] == pytest.approx(0.0014, abs=1e-4) and wide_fit["p_value"] < 1e-4
+
+
+def test_recorded_linear_fn_vs_p_diagnostics_rise_without_the_neighbour_grooves():
+    """docs/families_runs/linear_fn_vs_p (session 31): the family's S 100 mm cases at p 1.9 and 7.6 mm on three packings,
+    F_n over the family window. The family's F_n does not rise with p (239.7 -> 221.1 N, ratio 0.92 +- 0.16; each packing
+    0.86-1.01; the CSM model x2.38). Without the neighbour grooves (``unrel``) it does: 143.2 -> 253.5 N, x1.77 +- 0.38
+    (CSM x3.57). The session-26 runs re-parsed with their sems reproduce the 48-run table's means exactly."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    fam48 = pd.read_csv(rec.parent / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv").set_index("case")
+    sem = pd.read_csv(rec / "family_session26_sem" / "family_table.csv").set_index("case")
+    assert len(sem) == 16 and sem["force_normal_N_sem_steady"].gt(0).all()
+    assert sem["force_normal_N_mean_steady"].to_numpy() == pytest.approx(
+        fam48.loc[sem.index, "force_normal_N_mean_steady"].to_numpy(), abs=1e-9)
+    unrel = pd.read_csv(rec / "unrel" / "family_table.csv")
+    assert sorted(unrel["variant_case"]) == sorted(f"lin_red_s100_{p}{k}_unrel" for p in ("p1p9", "p7p6")
+                                                   for k in ("", "_k202", "_k303"))
+    assert unrel["run_completed"].all() and unrel["neighbour_spacing_mm"].isna().all()
+    assert set(unrel["block_height_mm"]) == {12} and unrel["n_grains"].between(2480, 2503).all()
+    for name in unrel["variant_case"]:
+        base = ROOT / "cases" / "linear_ccs" / "reduced" / f"{name.removesuffix('_unrel')}.yaml"
+        assert _diagnostic_changes(rec / f"{name}.yaml", base) == {("kinematics", "neighbour_spacing_mm"): (None, 12.5)}
+    mod = _docs_script(rec / "compare.py")
+    r = mod.ratios(("family", "unrel")).set_index(["config", "force"])
+    assert r.loc[("family", "F_n"), ["mean p1.9 N", "mean p7.6 N", "ratio 7.6/1.9", "se", "CSM ratio"]].to_list() == \
+        pytest.approx([239.67, 221.11, 0.923, 0.161, 2.383], abs=5e-3)
+    assert r.loc[("family", "F_n"), ["k12345", "k202", "k303"]].to_list() == pytest.approx([1.009, 0.863, 0.921], abs=5e-4)
+    assert r.loc[("family", "F_n"), "verdict"] == "flat"
+    assert r.loc[("unrel", "F_n"), ["mean p1.9 N", "mean p7.6 N", "ratio 7.6/1.9", "se", "CSM ratio"]].to_list() == \
+        pytest.approx([143.25, 253.49, 1.770, 0.378, 3.565], abs=5e-3)
+    assert r.loc[("unrel", "F_n"), "verdict"] == "rises"
 
 
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):
@@ -1068,13 +1122,16 @@ def _docs_script(path: Path):
     return mod
 
 
-def _diagnostic_changes(diag_path: Path) -> dict:
-    """The fields in which a rotary diagnostic case ``<family case>_<suffix>`` differs from its family case
-    (cases/rotary/reduced), name aside: ``{(section, field): (diagnostic value, family value)}``."""
+def _diagnostic_changes(diag_path: Path, base_path: Path | None = None) -> dict:
+    """The fields in which a diagnostic case differs from its family case, name aside:
+    ``{(section, field): (diagnostic value, family value)}``. The family case is ``base_path``, by default the rotary
+    case the name ``<family case>_<suffix>`` was made from (cases/rotary/reduced)."""
     import yaml
 
     diag = yaml.safe_load(diag_path.read_text())
-    base = yaml.safe_load((ROOT / "cases" / "rotary" / "reduced" / f"{diag['name'].rsplit('_', 1)[0]}.yaml").read_text())
+    if base_path is None:
+        base_path = ROOT / "cases" / "rotary" / "reduced" / f"{diag['name'].rsplit('_', 1)[0]}.yaml"
+    base = yaml.safe_load(base_path.read_text())
     assert diag.keys() == base.keys()
     changes = {}
     for section in diag.keys() - {"name"}:

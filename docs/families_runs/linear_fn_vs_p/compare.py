@@ -1,0 +1,147 @@
+"""F_n and the penetration on the reduced linear block (session 31).
+
+The reduced linear family's mean F_n does not rise with p (S 100 mm, three packings: 240 N at p 1.9 mm, 221 N at
+p 7.6 mm; seed 001 +76 %, the CSM model x2.4). This compares three configurations of the S 100 mm cases at p 1.9 and
+7.6 mm (full-scale values; reduced 0.95 and 3.8 mm) on the family's three packings (12345, 202, 303):
+
+- ``family``: the family cases (neighbour grooves at +-12.5 mm, block 26 x 33 x 12 mm), from the 48-run report; the
+  sems of packings 202 and 303 from their session-26 runs re-parsed in session 31 (``family_session26_sem``: the same
+  means), packing 12345 (session 22, run folders gone) has none;
+- ``unrel``: the same cases without the neighbour grooves (an unrelieved cut), ``unrel/``;
+- ``unrel_h24``: unrelieved on a block twice as high (24 mm), ``unrel_h24/``.
+
+Prints one row per run (F_n, F_r with their standard errors, F_r/F_n, broken fraction, the volume of chips and
+debris over the groove's, grains, wall) and one row per
+configuration: the ratio p 7.6 / p 1.9 of the packing means of F_n and F_r with its standard error, each packing's own
+ratio, and the CSM model's ratio for the same cases (:mod:`deckgen.gap.fast` at the cutting card's targets, softened as
+the cases are) as the yardstick. The standard error of a packing mean is the larger of the packings' scatter
+(std / sqrt(n)) and the runs' own sems (sqrt(sum sem^2) / n; a run without a sem takes the median relative sem of the
+others); the ratio's adds the two means' relative errors in quadrature. Verdict (rule written before the runs,
+session 31 predictions): "rises" if the ratio is >= 1.3 and 2 s.e. above 1, "flat" if 1 lies within 2 s.e.
+
+    python docs/families_runs/linear_fn_vs_p/compare.py
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[2]
+FAMILY48 = HERE.parent / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv"
+FAMILY_SEM = HERE / "family_session26_sem" / "family_table.csv"
+CONFIGS = ("family", "unrel", "unrel_h24")
+PENETRATIONS = (1.9, 7.6)  # full-scale mm
+PACKINGS = (12345, 202, 303)
+FORCES = {"F_n": "force_normal_N", "F_r": "force_rolling_N"}
+#: the cutting card's targets (cases/materials/cutting/colorado_red_granite.yaml) and the cases' softening
+CARD_UCS_MPA, CARD_BTS_MPA, SOFTENING = 110.6, 13.83, 14.521
+
+
+def runs(config: str) -> pd.DataFrame:
+    """The S 100 mm runs of one configuration at p 1.9 and 7.6 mm, indexed by (penetration_full_mm, packing_seed)."""
+    if config == "family":
+        t = pd.read_csv(FAMILY48)
+        sem = pd.read_csv(FAMILY_SEM).set_index("case")
+        t = t[t["spacing_full_mm"] == 100].set_index("case")
+        for col in (f"{c}_sem_steady" for c in FORCES.values()):
+            t[col] = sem[col].reindex(t.index)
+        t = t.reset_index()
+    else:
+        path = HERE / config / "family_table.csv"
+        if not path.is_file():
+            raise SystemExit(f"{path}: no report yet (fix: run the {config} diagnostics and report them, docs/families.md, section F_n and the penetration)")
+        t = pd.read_csv(path)
+    t = t[t["penetration_full_mm"].isin(PENETRATIONS)]
+    return t.set_index(["penetration_full_mm", "packing_seed"]).sort_index()
+
+
+def mean_and_se(values: pd.Series, sems: pd.Series) -> tuple[float, float]:
+    """Mean over packings and its standard error: the larger of the scatter's std/sqrt(n) and sqrt(sum sem^2)/n, a
+    missing sem taken as the median relative sem of the others."""
+    v = values.to_numpy(float)
+    s = sems.to_numpy(float)
+    rel = s / np.abs(v)
+    if np.isfinite(rel).any():
+        s = np.where(np.isfinite(s), s, np.nanmedian(rel) * np.abs(v))
+    n = len(v)
+    scatter = v.std(ddof=1) / math.sqrt(n) if n > 1 else float("nan")
+    own = math.sqrt(float(np.sum(s**2))) / n if np.isfinite(s).all() else float("nan")
+    return float(v.mean()), float(np.nanmax([scatter, own]))
+
+
+def verdict(ratio: float, se: float) -> str:
+    if ratio >= 1.3 and ratio - 2 * se > 1:
+        return "rises"
+    if abs(ratio - 1) <= 2 * se:
+        return "flat"
+    return "falls" if ratio < 1 else "rises (< 1.3)"
+
+
+def csm_ratio(config: str) -> float:
+    """The CSM model's F_n(p 7.6) / F_n(p 1.9) for the configuration's packing-12345 cases."""
+    from deckgen.gap.data import flat_case
+    from deckgen.gap.fast import predict_row
+    from deckgen.spec import load_case
+
+    fn = []
+    for p in ("p1p9", "p7p6"):
+        f = (ROOT / "cases" / "linear_ccs" / "reduced" / f"lin_red_s100_{p}.yaml" if config == "family"
+             else HERE / f"lin_red_s100_{p}_{config}.yaml")
+        row = flat_case(load_case(f))
+        row["material.targets.ucs_MPa"] = CARD_UCS_MPA / SOFTENING
+        row["material.targets.bts_MPa"] = CARD_BTS_MPA / SOFTENING
+        fn.append(predict_row(row)["force_normal_N_mean_steady"])
+    return fn[1] / fn[0]
+
+
+def per_run(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
+    rows = []
+    for c in configs:
+        t = runs(c)
+        for (p, k), r in t.iterrows():
+            rows.append({"config": c, "p_full_mm": p, "packing": k, "grains": int(r["n_grains"]),
+                         "wall_min": r["wall_s"] / 60,
+                         **{f"{q} N": r[f"{col}_mean_steady"] for q, col in FORCES.items()},
+                         **{f"{q} sem": r[f"{col}_sem_steady"] for q, col in FORCES.items()},
+                         "F_r/F_n": r["rolling_to_normal_ratio_1"], "broken": r["broken_fraction_1"],
+                         "bonds_broken": int(r["bonds_broken"]),
+                         # (chips + debris) volume over the groove's: SE_kinematic / SE_chips = Q_chips / Q_kinematic
+                         "removed/groove": r["specific_energy_kinematic_J_m3"] / r["specific_energy_chips_J_m3"]})
+    return pd.DataFrame(rows)
+
+
+def ratios(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
+    """Per configuration and force: packing means at p 1.9 and 7.6 mm with s.e., their ratio with s.e. and verdict,
+    each packing's own ratio, and the CSM model's F_n ratio."""
+    rows = []
+    for c in configs:
+        t = runs(c)
+        for q, col in FORCES.items():
+            lo = t.loc[PENETRATIONS[0]]
+            hi = t.loc[PENETRATIONS[1]]
+            m0, e0 = mean_and_se(lo[f"{col}_mean_steady"], lo[f"{col}_sem_steady"])
+            m1, e1 = mean_and_se(hi[f"{col}_mean_steady"], hi[f"{col}_sem_steady"])
+            ratio = m1 / m0
+            se = abs(ratio) * math.hypot(e0 / m0, e1 / m1)
+            own = (hi[f"{col}_mean_steady"] / lo[f"{col}_mean_steady"]).reindex(list(PACKINGS))
+            rows.append({"config": c, "force": q, "mean p1.9 N": m0, "se p1.9": e0, "mean p7.6 N": m1, "se p7.6": e1,
+                         "ratio 7.6/1.9": ratio, "se": se, "verdict": verdict(ratio, se),
+                         **{f"k{k}": v for k, v in own.items()},
+                         "CSM ratio": csm_ratio(c) if q == "F_n" else float("nan")})
+    return pd.DataFrame(rows)
+
+
+def main() -> None:
+    have = tuple(c for c in CONFIGS if c == "family" or (HERE / c / "family_table.csv").is_file())
+    pd.set_option("display.width", 200)
+    print(per_run(have).round(3).to_string(index=False))
+    print()
+    print(ratios(have).round(3).to_string(index=False))
+
+
+if __name__ == "__main__":
+    main()

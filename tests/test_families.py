@@ -930,6 +930,44 @@ def test_recorded_linear_fn_vs_p_diagnostics_rise_without_the_neighbour_grooves(
     assert r.loc[("unrel", "F_n"), "verdict"] == "rises"
 
 
+def test_recorded_linear_fn_vs_p_diagnostics_finer_shell_and_longer_block():
+    """docs/families_runs/linear_fn_vs_p (session 31): a shell with its centres twice as close (``shell0p5``) stops the
+    leak at p 7.6 mm (1-3 grains inside the tip at the end, family 9-14) and lifts F_n at both depths (means 366.0 and
+    538.3 N against 239.7 and 221.1 N; over the six runs x2.02 the family run of the same packing and p), its ratio
+    p 7.6 / p 1.9 x1.47 +- 0.36 ("flat" by the rule); spacing 0.35 moves one run by -7 % (converged). The 45 mm block at
+    p 1.9 mm (packing 12345): 133.5 N, x0.68."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    reduced = ROOT / "cases" / "linear_ccs" / "reduced"
+    shell = pd.read_csv(rec / "shell0p5" / "family_table.csv")
+    assert sorted(shell["variant_case"]) == sorted(f"lin_red_s100_{p}{k}_shell0p5" for p in ("p1p9", "p7p6")
+                                                   for k in ("", "_k202", "_k303"))
+    assert shell["run_completed"].all() and (shell["neighbour_spacing_mm"] == 12.5).all()
+    for name in shell["variant_case"]:
+        assert _diagnostic_changes(rec / f"{name}.yaml", reduced / f"{name.removesuffix('_shell0p5')}.yaml") == {
+            ("cutter", "shell_spacing"): (0.5, None)}
+    block = pd.read_csv(rec / "block45" / "family_table.csv")
+    assert list(block["variant_case"]) == ["lin_red_s100_p1p9_block45"] and list(block["n_grains"]) == [4266]
+    assert _diagnostic_changes(rec / "lin_red_s100_p1p9_block45.yaml", reduced / "lin_red_s100_p1p9.yaml") == {
+        ("specimen", "length_mm"): (45, 26)}
+    mod = _docs_script(rec / "compare.py")
+    runs = mod.per_run(("shell0p5", "block45")).set_index(["config", "p_full_mm", "packing"]).sort_index()
+    assert runs.loc["shell0p5", "inside"].to_list() == [0, 0, 0, 1, 3, 1]  # p 1.9 then 7.6; packings 202, 303, 12345
+    assert runs.loc["shell0p5", "F_n/family"].mean() == pytest.approx(2.020, abs=5e-3)
+    assert runs.loc[("block45", 1.9, 12345), ["F_n N", "F_n/family"]].to_list() == pytest.approx([133.55, 0.676], abs=5e-3)
+    # the shell converged at 0.5: spacing 0.35 (6332 spheres) moves packing 12345's p 1.9 mm run by -7 %
+    fine = mod.per_run(("shell0p35",)).set_index(["p_full_mm", "packing"]).loc[(1.9, 12345)]
+    assert _diagnostic_changes(rec / "lin_red_s100_p1p9_shell0p35.yaml", reduced / "lin_red_s100_p1p9.yaml") == {
+        ("cutter", "shell_spacing"): (0.35, None)}
+    assert fine["F_n N"] == pytest.approx(411.94, abs=5e-3) and fine["inside"] == 0
+    assert fine["F_n N"] / runs.loc[("shell0p5", 1.9, 12345), "F_n N"] == pytest.approx(0.934, abs=5e-4)
+    r = mod.ratios(("shell0p5",)).set_index(["config", "force"]).loc[("shell0p5", "F_n")]
+    assert r[["mean p1.9 N", "mean p7.6 N", "ratio 7.6/1.9", "se"]].to_list() == pytest.approx(
+        [365.97, 538.33, 1.471, 0.358], abs=5e-3)
+    assert r["verdict"] == "flat"
+
+
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):
     """docs/families_runs/rotary_reduced_5packings: the 12 runs above plus packings 404 and 505 (session 25, 20 runs).
     F_r/F_n changes -2 % from r 250 to 1000 mm (95 % interval -15 % to +14 %, p 0.75), so the seed's -47 % is excluded;

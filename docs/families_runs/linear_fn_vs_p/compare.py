@@ -8,10 +8,13 @@ p 7.6 mm; seed 001 +76 %, the CSM model x2.4). This compares three configuration
   sems of packings 202 and 303 from their session-26 runs re-parsed in session 31 (``family_session26_sem``: the same
   means), packing 12345 (session 22, run folders gone) has none;
 - ``unrel``: the same cases without the neighbour grooves (an unrelieved cut), ``unrel/``;
-- ``unrel_h24``: unrelieved on a block twice as high (24 mm), ``unrel_h24/``.
+- ``shell0p5``: the family cases with a shell twice as dense (``cutter.shell_spacing`` 0.5), ``shell0p5/``;
+- ``shell0p35``: the same with ``shell_spacing`` 0.35 (p 1.9 mm, packing 12345 only), ``shell0p35/``;
+- ``block45``: the family cases on a block 45 mm long (start, travel and window unchanged; p 1.9 mm, packing 12345
+  only), ``block45/``.
 
-Prints one row per run (F_n, F_r with their standard errors, F_r/F_n, broken fraction, the volume of chips and
-debris over the groove's, grains, wall) and one row per
+Prints one row per run (F_n, F_r with their standard errors, F_r/F_n, broken fraction, grains inside the cutter
+at the end, the volume of chips and debris over the groove's, grains, wall) and one row per
 configuration: the ratio p 7.6 / p 1.9 of the packing means of F_n and F_r with its standard error, each packing's own
 ratio, and the CSM model's ratio for the same cases (:mod:`deckgen.gap.fast` at the cutting card's targets, softened as
 the cases are) as the yardstick. The standard error of a packing mean is the larger of the packings' scatter
@@ -20,10 +23,13 @@ others); the ratio's adds the two means' relative errors in quadrature. Verdict 
 session 31 predictions): "rises" if the ratio is >= 1.3 and 2 s.e. above 1, "flat" if 1 lies within 2 s.e.
 
     python docs/families_runs/linear_fn_vs_p/compare.py
+    python docs/families_runs/linear_fn_vs_p/compare.py --climb <parsed folder> ...   # F_n along the travel, per run
 """
 from __future__ import annotations
 
+import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +39,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
 FAMILY48 = HERE.parent / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv"
 FAMILY_SEM = HERE / "family_session26_sem" / "family_table.csv"
-CONFIGS = ("family", "unrel", "unrel_h24")
+CONFIGS = ("family", "unrel", "shell0p5", "shell0p35", "block45")
 PENETRATIONS = (1.9, 7.6)  # full-scale mm
 PACKINGS = (12345, 202, 303)
 FORCES = {"F_n": "force_normal_N", "F_r": "force_rolling_N"}
@@ -99,16 +105,19 @@ def csm_ratio(config: str) -> float:
 
 
 def per_run(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
+    """One row per run; ``F_n/family`` is its F_n over the family run of the same packing and p."""
     rows = []
+    family = runs("family")["force_normal_N_mean_steady"]
     for c in configs:
         t = runs(c)
         for (p, k), r in t.iterrows():
             rows.append({"config": c, "p_full_mm": p, "packing": k, "grains": int(r["n_grains"]),
                          "wall_min": r["wall_s"] / 60,
                          **{f"{q} N": r[f"{col}_mean_steady"] for q, col in FORCES.items()},
+                         "F_n/family": r["force_normal_N_mean_steady"] / family[p, k],
                          **{f"{q} sem": r[f"{col}_sem_steady"] for q, col in FORCES.items()},
                          "F_r/F_n": r["rolling_to_normal_ratio_1"], "broken": r["broken_fraction_1"],
-                         "bonds_broken": int(r["bonds_broken"]),
+                         "bonds_broken": int(r["bonds_broken"]), "inside": r["grains_inside_cutter_final"],
                          # (chips + debris) volume over the groove's: SE_kinematic / SE_chips = Q_chips / Q_kinematic
                          "removed/groove": r["specific_energy_kinematic_J_m3"] / r["specific_energy_chips_J_m3"]})
     return pd.DataFrame(rows)
@@ -120,6 +129,8 @@ def ratios(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
     rows = []
     for c in configs:
         t = runs(c)
+        if not all(p in t.index.get_level_values(0) for p in PENETRATIONS):
+            continue  # a configuration run at one penetration only
         for q, col in FORCES.items():
             lo = t.loc[PENETRATIONS[0]]
             hi = t.loc[PENETRATIONS[1]]
@@ -135,7 +146,28 @@ def ratios(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+#: fractions of the travel :func:`climb` averages F_n over (the family window is 0.77-0.99)
+CLIMB_BINS = ((0.4, 0.6), (0.6, 0.8), (0.8, 1.0))
+
+
+def climb(parsed: list[Path]) -> pd.DataFrame:
+    """Mean F_n of each run over :data:`CLIMB_BINS` of the travel and the last bin over the first: how much the force
+    still climbs along the travel (a run-in or the fixed end face ahead)."""
+    rows = []
+    for d in map(Path, parsed):
+        s = json.loads((d / "summary.json").read_text())
+        ts = pd.read_parquet(d / "timeseries.parquet", columns=["time_s", "force_normal_N"])
+        f = ts["time_s"] / float(s["cut_duration_s"])
+        means = {f"F_n {a:g}-{b:g}": ts.loc[(f >= a) & (f < b), "force_normal_N"].mean() for a, b in CLIMB_BINS}
+        first, last = means[f"F_n {CLIMB_BINS[0][0]:g}-{CLIMB_BINS[0][1]:g}"], means[f"F_n {CLIMB_BINS[-1][0]:g}-{CLIMB_BINS[-1][1]:g}"]
+        rows.append({"run": s["case"], **means, "last/first": last / first})
+    return pd.DataFrame(rows)
+
+
 def main() -> None:
+    if len(sys.argv) > 2 and sys.argv[1] == "--climb":
+        print(climb([Path(a) for a in sys.argv[2:]]).round(3).to_string(index=False))
+        return
     have = tuple(c for c in CONFIGS if c == "family" or (HERE / c / "family_table.csv").is_file())
     pd.set_option("display.width", 200)
     print(per_run(have).round(3).to_string(index=False))

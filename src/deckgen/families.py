@@ -829,13 +829,14 @@ TABLE_FIELDS = [
 ]
 
 
-#: Kinematics tokens a diagnostic variant of a family case may change; ``family_table(variants=True)`` reports them
-#: (a resolved case leaves some out at their defaults, which come from the spec).
-VARIANT_TOKENS = ("spin", "shaft_sense", "penetration_at", "orbit_lift_ratio")
-# (column, section of the case, field): the cutter's surface and friction of a variant beside its kinematics, and the
-# neighbour grooves (NaN: an unrelieved cut) and block height, which a variant of a linear case may change
-VARIANT_FIELDS = (("cutter_surface", "cutter", "surface"), ("cutter_friction_1", "contact", "cutter_friction"),
-                  ("neighbour_spacing_mm", "kinematics", "neighbour_spacing_mm"), ("block_height_mm", "specimen", "height_mm"))
+#: (column, section of the case, field) a diagnostic variant of a family case may change; ``family_table(variants=True)``
+#: reports them from the run's spec.json (a resolved case leaves some out at their defaults, which come from the spec):
+#: kinematics tokens, the cutter's surface and friction, the neighbour grooves (NaN: an unrelieved cut) and block height.
+VARIANT_FIELDS = (
+    *((token, "kinematics", token) for token in ("spin", "shaft_sense", "penetration_at", "orbit_lift_ratio")),
+    ("cutter_surface", "cutter", "surface"), ("cutter_friction_1", "contact", "cutter_friction"),
+    ("neighbour_spacing_mm", "kinematics", "neighbour_spacing_mm"), ("block_height_mm", "specimen", "height_mm"),
+)
 
 
 def _variant_base(case: str, known: "set[str]", where: Path) -> str:
@@ -876,9 +877,9 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     ``variants``: the runs are diagnostic variants of family cases (e.g. ``odc_red_s12_nospin_bottom``, a copy of
     ``odc_red_s12`` with other kinematics): each row takes the factors of its family case, whose name stays in
-    ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case``, the kinematics
-    tokens of :data:`VARIANT_TOKENS` and the cutter's surface and friction, neighbour spacing and block height
-    (:data:`VARIANT_FIELDS`) from its spec.json.
+    ``case`` (so the family's trend filters apply), with the run's own name in ``variant_case``, its kinematics
+    tokens, the cutter's surface and friction, neighbour spacing and block height (:data:`VARIANT_FIELDS`) from its
+    spec.json.
 
     ``same_as``: run case name -> family case name, for runs of a copy of a family case under another name (e.g. a
     diagnostic that the generator later took over). Each is checked: the run's resolved case in spec.json must be the
@@ -892,7 +893,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
     if variants:  # a variant's own kinematics tokens and cutter columns win over its family case's factors
-        idx_factors = idx.drop(columns=[c for c in (*VARIANT_TOKENS, *(v[0] for v in VARIANT_FIELDS)) if c in idx.columns])
+        idx_factors = idx.drop(columns=[c for c, _, _ in VARIANT_FIELDS if c in idx.columns])
     rows = []
     for d in map(Path, parsed_dirs):
         summary = d / "summary.json"
@@ -917,9 +918,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             _check_same_case(spec, Path(index_csv).parent / rel, summary)
             s = {**s, "case": target}
         elif variants:
-            kin = spec.get("case", {}).get("kinematics", {})
             row["variant_case"] = s["case"]
-            row.update({k: kin.get(k, Kinematics.model_fields[k].default) for k in VARIANT_TOKENS})
             models = {"cutter": Cutter, "contact": Contact, "kinematics": Kinematics, "specimen": CuttingBlock}
             row.update({col: spec.get("case", {}).get(sec, {}).get(f, models[sec].model_fields[f].default)
                         for col, sec, f in VARIANT_FIELDS})
@@ -934,7 +933,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
         except (TypeError, ValueError, ZeroDivisionError):
             row["lateral_to_normal_ratio_1"] = float("nan")
         rows.append({"case": s["case"], **row})
-    extra = ["variant_case", *VARIANT_TOKENS, *(c[0] for c in VARIANT_FIELDS)] if variants else []
+    extra = ["variant_case", *(c for c, _, _ in VARIANT_FIELDS)] if variants else []
     runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1",
                                        *extra])
     if variants and runs["case"].duplicated().any():

@@ -35,6 +35,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from deckgen.results import steady_mask
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[2]
 FAMILY48 = HERE.parent / "linear_reduced_bpm_granite_replicates_48" / "family_table.csv"
@@ -157,10 +159,9 @@ def climb(parsed: list[Path]) -> pd.DataFrame:
     for d in map(Path, parsed):
         s = json.loads((d / "summary.json").read_text())
         ts = pd.read_parquet(d / "timeseries.parquet", columns=["time_s", "force_normal_N"])
-        f = ts["time_s"] / float(s["cut_duration_s"])
-        means = {f"F_n {a:g}-{b:g}": ts.loc[(f >= a) & (f < b), "force_normal_N"].mean() for a, b in CLIMB_BINS}
-        first, last = means[f"F_n {CLIMB_BINS[0][0]:g}-{CLIMB_BINS[0][1]:g}"], means[f"F_n {CLIMB_BINS[-1][0]:g}-{CLIMB_BINS[-1][1]:g}"]
-        rows.append({"run": s["case"], **means, "last/first": last / first})
+        means = [ts.loc[steady_mask(ts["time_s"], s["cut_duration_s"], w), "force_normal_N"].mean() for w in CLIMB_BINS]
+        rows.append({"run": s["case"], **{f"F_n {a:g}-{b:g}": m for (a, b), m in zip(CLIMB_BINS, means)},
+                     "last/first": means[-1] / means[0]})
     return pd.DataFrame(rows)
 
 

@@ -24,6 +24,7 @@ session 31 predictions): "rises" if the ratio is >= 1.3 and 2 s.e. above 1, "fla
 
     python docs/families_runs/linear_fn_vs_p/compare.py
     python docs/families_runs/linear_fn_vs_p/compare.py --climb <parsed folder> ...   # F_n along the travel, per run
+    python docs/families_runs/linear_fn_vs_p/compare.py --spacing   # session 32: shell0p5 at S 25-100 mm vs the family
 """
 from __future__ import annotations
 
@@ -49,12 +50,12 @@ FORCES = {"F_n": "force_normal_N", "F_r": "force_rolling_N"}
 CARD_UCS_MPA, CARD_BTS_MPA, SOFTENING = 110.6, 13.83, 14.521
 
 
-def runs(config: str) -> pd.DataFrame:
-    """The S 100 mm runs of one configuration at p 1.9 and 7.6 mm, indexed by (penetration_full_mm, packing_seed)."""
+def table(config: str) -> pd.DataFrame:
+    """Every run of one configuration at p 1.9 and 7.6 mm, at every spacing it was run at."""
     if config == "family":
         t = pd.read_csv(FAMILY48)
         sem = pd.read_csv(FAMILY_SEM).set_index("case")
-        t = t[t["spacing_full_mm"] == 100].set_index("case")
+        t = t.set_index("case")
         for col in (f"{c}_sem_steady" for c in FORCES.values()):
             t[col] = sem[col].reindex(t.index)
         t = t.reset_index()
@@ -63,7 +64,14 @@ def runs(config: str) -> pd.DataFrame:
         if not path.is_file():
             raise SystemExit(f"{path}: no report yet (fix: run the {config} diagnostics and report them, docs/families.md, section F_n and the penetration)")
         t = pd.read_csv(path)
-    t = t[t["penetration_full_mm"].isin(PENETRATIONS)]
+    return t[t["penetration_full_mm"].isin(PENETRATIONS)]
+
+
+def runs(config: str, spacing: float = 100) -> pd.DataFrame:
+    """The runs of one configuration at spacing S (full-scale mm) at p 1.9 and 7.6 mm, indexed by
+    (penetration_full_mm, packing_seed)."""
+    t = table(config)
+    t = t[t["spacing_full_mm"] == spacing]
     return t.set_index(["penetration_full_mm", "packing_seed"]).sort_index()
 
 
@@ -89,16 +97,16 @@ def verdict(ratio: float, se: float) -> str:
     return "falls" if ratio < 1 else "rises (< 1.3)"
 
 
-def csm_ratio(config: str) -> float:
-    """The CSM model's F_n(p 7.6) / F_n(p 1.9) for the configuration's packing-12345 cases."""
+def csm_ratio(config: str, spacing: float = 100) -> float:
+    """The CSM model's F_n(p 7.6) / F_n(p 1.9) for the configuration's packing-12345 cases at spacing S."""
     from deckgen.gap.data import flat_case
     from deckgen.gap.fast import predict_row
     from deckgen.spec import load_case
 
     fn = []
     for p in ("p1p9", "p7p6"):
-        f = (ROOT / "cases" / "linear_ccs" / "reduced" / f"lin_red_s100_{p}.yaml" if config == "family"
-             else HERE / f"lin_red_s100_{p}_{config}.yaml")
+        f = (ROOT / "cases" / "linear_ccs" / "reduced" / f"lin_red_s{spacing:g}_{p}.yaml" if config == "family"
+             else HERE / f"lin_red_s{spacing:g}_{p}_{config}.yaml")
         row = flat_case(load_case(f))
         row["material.targets.ucs_MPa"] = CARD_UCS_MPA / SOFTENING
         row["material.targets.bts_MPa"] = CARD_BTS_MPA / SOFTENING
@@ -106,12 +114,12 @@ def csm_ratio(config: str) -> float:
     return fn[1] / fn[0]
 
 
-def per_run(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
-    """One row per run; ``F_n/family`` is its F_n over the family run of the same packing and p."""
+def per_run(configs: tuple[str, ...] = CONFIGS, spacing: float = 100) -> pd.DataFrame:
+    """One row per run at spacing S; ``F_n/family`` is its F_n over the family run of the same S, packing and p."""
     rows = []
-    family = runs("family")["force_normal_N_mean_steady"]
+    family = runs("family", spacing)["force_normal_N_mean_steady"]
     for c in configs:
-        t = runs(c)
+        t = runs(c, spacing)
         for (p, k), r in t.iterrows():
             rows.append({"config": c, "p_full_mm": p, "packing": k, "grains": int(r["n_grains"]),
                          "wall_min": r["wall_s"] / 60,
@@ -125,12 +133,12 @@ def per_run(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def ratios(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
-    """Per configuration and force: packing means at p 1.9 and 7.6 mm with s.e., their ratio with s.e. and verdict,
-    each packing's own ratio, and the CSM model's F_n ratio."""
+def ratios(configs: tuple[str, ...] = CONFIGS, spacing: float = 100) -> pd.DataFrame:
+    """Per configuration and force at spacing S: packing means at p 1.9 and 7.6 mm with s.e., their ratio with s.e. and
+    verdict, each packing's own ratio, and the CSM model's F_n ratio."""
     rows = []
     for c in configs:
-        t = runs(c)
+        t = runs(c, spacing)
         if not all(p in t.index.get_level_values(0) for p in PENETRATIONS):
             continue  # a configuration run at one penetration only
         for q, col in FORCES.items():
@@ -144,7 +152,54 @@ def ratios(configs: tuple[str, ...] = CONFIGS) -> pd.DataFrame:
             rows.append({"config": c, "force": q, "mean p1.9 N": m0, "se p1.9": e0, "mean p7.6 N": m1, "se p7.6": e1,
                          "ratio 7.6/1.9": ratio, "se": se, "verdict": verdict(ratio, se),
                          **{f"k{k}": v for k, v in own.items()},
-                         "CSM ratio": csm_ratio(c) if q == "F_n" else float("nan")})
+                         "CSM ratio": csm_ratio(c, spacing) if q == "F_n" else float("nan")})
+    return pd.DataFrame(rows)
+
+
+#: the spacings of the family (full-scale mm)
+SPACINGS = (25, 51, 76, 100)
+
+
+def by_spacing(configs: tuple[str, ...] = ("family", "shell0p5")) -> pd.DataFrame:
+    """Per configuration, force and p: the packing mean (with s.e., :func:`mean_and_se`) at each spacing the
+    configuration was run at, and the ratio S 100 / S 25 with its s.e. and :func:`verdict` (session 32: does F_n still
+    rise with S once the shell stops leaking grains into the tip?)."""
+    rows = []
+    for c in configs:
+        t = table(c)
+        for q, col in FORCES.items():
+            for p in PENETRATIONS:
+                row: dict = {"config": c, "force": q, "p_full_mm": p}
+                stats = {}
+                for s in SPACINGS:
+                    at = t[(t["spacing_full_mm"] == s) & (t["penetration_full_mm"] == p)]
+                    if len(at):
+                        stats[s] = mean_and_se(at[f"{col}_mean_steady"], at[f"{col}_sem_steady"])
+                        row[f"S{s} N"], row[f"se S{s}"] = stats[s]
+                if 25 in stats and 100 in stats:
+                    (m0, e0), (m1, e1) = stats[25], stats[100]
+                    row["ratio S100/S25"] = m1 / m0
+                    row["se"] = abs(m1 / m0) * math.hypot(e0 / m0, e1 / m1)
+                    row["verdict"] = verdict(row["ratio S100/S25"], row["se"])
+                rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def matched_trends(config: str = "shell0p5") -> pd.DataFrame:
+    """The family's linear trends (:func:`deckgen.families.trend_table`) fitted on a configuration's runs and on the
+    family runs of the same cases (same S, p and packing), side by side."""
+    from deckgen.families import trend_table
+
+    var = pd.read_csv(HERE / config / "family_table.csv")
+    fam = pd.read_csv(FAMILY48)
+    fam = fam[fam["case"].isin(var["variant_case"].str.removesuffix(f"_{config}"))]
+    rows = []
+    for name, t in (("family", fam), (config, var)):
+        fit = trend_table("linear_ccs", t)
+        for _, r in fit.iterrows():
+            rows.append({"config": name, "trend": r["trend"], "runs": r["runs"], "change": r["change_1"],
+                         "ci95 low": r["change_1_ci95_low"], "ci95 high": r["change_1_ci95_high"],
+                         "p_value": r["p_value"], "seed": r["seed_change_1"]})
     return pd.DataFrame(rows)
 
 
@@ -166,11 +221,19 @@ def climb(parsed: list[Path]) -> pd.DataFrame:
 
 
 def main() -> None:
+    pd.set_option("display.width", 200)
+    if len(sys.argv) > 1 and sys.argv[1] == "--spacing":
+        for sp in SPACINGS[:-1]:
+            print(per_run(("shell0p5",), sp).round(3).to_string(index=False))
+        print()
+        print(by_spacing().round(3).to_string(index=False))
+        print()
+        print(matched_trends().round(4).to_string(index=False))
+        return
     if len(sys.argv) > 2 and sys.argv[1] == "--climb":
         print(climb([Path(a) for a in sys.argv[2:]]).round(3).to_string(index=False))
         return
     have = tuple(c for c in CONFIGS if c == "family" or (HERE / c / "family_table.csv").is_file())
-    pd.set_option("display.width", 200)
     print(per_run(have).round(3).to_string(index=False))
     print()
     print(ratios(have).round(3).to_string(index=False))

@@ -969,6 +969,49 @@ def test_recorded_linear_fn_vs_p_diagnostics_finer_shell_and_longer_block():
     assert r["verdict"] == "flat"
 
 
+def test_recorded_linear_finer_shell_keeps_the_spacing_and_ratio_trends():
+    """docs/families_runs/linear_fn_vs_p/shell0p5 (session 32): the finer shell (``shell_spacing`` 0.5) on every spacing
+    at p 1.9 and 7.6 mm and three packings (24 runs; session 31's six at S 100 mm and 18 at S 25/51/76 mm). F_n still
+    rises with S, more than on the family runs of the same cases; F_r/F_n still rises with p, and where the grooves
+    leave an intact ridge (S >= 76 mm) by more than on the family runs. At S <= 51 mm the finer shell does not lift
+    F_n on average (per run x0.33-5.2); at S >= 76 mm it does."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    reduced = ROOT / "cases" / "linear_ccs" / "reduced"
+    shell = pd.read_csv(rec / "shell0p5" / "family_table.csv")
+    assert sorted(shell["variant_case"]) == sorted(f"lin_red_s{s}_{p}{k}_shell0p5" for s in (25, 51, 76, 100)
+                                                   for p in ("p1p9", "p7p6") for k in ("", "_k202", "_k303"))
+    assert shell["run_completed"].all() and shell["grains_inside_cutter_final"].le(3).all()
+    for name in shell["variant_case"]:
+        assert _diagnostic_changes(rec / f"{name}.yaml", reduced / f"{name.removesuffix('_shell0p5')}.yaml") == {
+            ("cutter", "shell_spacing"): (0.5, None)}
+    mod = _docs_script(rec / "compare.py")
+    gain = {s: mod.per_run(("shell0p5",), s)["F_n/family"] for s in mod.SPACINGS}
+    assert [round(g.mean(), 3) for g in gain.values()] == pytest.approx([2.008, 1.686, 2.286, 2.020], abs=1e-3)
+    assert [round(g.min(), 3) for g in gain.values()] == pytest.approx([0.662, 0.326, 1.010, 0.907], abs=1e-3)
+    s = mod.by_spacing().set_index(["config", "force", "p_full_mm"])
+    cols = ["S25 N", "S51 N", "S76 N", "S100 N", "ratio S100/S25", "se"]
+    for key, want in {("family", "F_n", 1.9): [100.32, 169.65, 116.58, 239.67, 2.389, 0.474],
+                      ("family", "F_n", 7.6): [78.39, 83.94, 209.48, 221.11, 2.821, 1.028],
+                      ("shell0p5", "F_n", 1.9): [144.695, 117.915, 304.832, 365.968, 2.529, 0.724],
+                      ("shell0p5", "F_n", 7.6): [117.42, 204.01, 320.20, 538.33, 4.585, 1.034]}.items():
+        assert s.loc[key, cols].to_list() == pytest.approx(want, abs=5e-3), key
+    assert s.loc[("shell0p5", "F_n", 1.9), "verdict"] == "rises" and s.loc[("shell0p5", "F_n", 7.6), "verdict"] == "rises"
+    assert s.loc[("family", "F_n", 7.6), "verdict"] == "flat"
+    # F_n p 7.6 / p 1.9 at each spacing: flat by the rule on the finer shell too (x0.81, 1.73, 1.05, 1.47)
+    assert [round(mod.ratios(("shell0p5",), sp).set_index("force").loc["F_n", "ratio 7.6/1.9"], 3) for sp in mod.SPACINGS] == \
+        pytest.approx([0.811, 1.730, 1.050, 1.471], abs=1e-3)
+    t = mod.matched_trends().set_index(["config", "trend"])
+    for key, want in {("family", "fn_rises_with_s"): [24, 1.6641, 0.7182, 3.6408, 0.0001],
+                      ("shell0p5", "fn_rises_with_s"): [24, 3.8957, 1.6289, 20.4959, 0.0],
+                      ("family", "fr_fn_rises_with_p"): [24, 0.9826, 0.1328, 3.0776, 0.0182],
+                      ("shell0p5", "fr_fn_rises_with_p"): [24, 1.0233, 0.1851, 5.4272, 0.0101],
+                      ("family", "fr_fn_rises_with_p_intact_ridge"): [12, 1.0261, 0.2955, 2.4996, 0.0052],
+                      ("shell0p5", "fr_fn_rises_with_p_intact_ridge"): [12, 1.8598, 0.8693, 3.9957, 0.0002]}.items():
+        assert t.loc[key, ["runs", "change", "ci95 low", "ci95 high", "p_value"]].to_list() == pytest.approx(want, abs=5e-4), key
+
+
 def test_recorded_rotary_runs_on_five_packings_exclude_the_seeds_ratio_trend_but_give_its_normal_force_rise(tmp_path):
     """docs/families_runs/rotary_reduced_5packings: the 12 runs above plus packings 404 and 505 (session 25, 20 runs).
     F_r/F_n changes -2 % from r 250 to 1000 mm (95 % interval -15 % to +14 %, p 0.75), so the seed's -47 % is excluded;

@@ -8,7 +8,8 @@ p 7.6 mm; seed 001 +76 %, the CSM model x2.4). This compares three configuration
   sems of packings 202 and 303 from their session-26 runs re-parsed in session 31 (``family_session26_sem``: the same
   means), packing 12345 (session 22, run folders gone) has none;
 - ``unrel``: the same cases without the neighbour grooves (an unrelieved cut), ``unrel/``;
-- ``shell0p5``: the family cases with a shell twice as dense (``cutter.shell_spacing`` 0.5), ``shell0p5/``;
+- ``shell0p5``: the family cases with a shell twice as dense (``cutter.shell_spacing`` 0.5), ``shell0p5/`` (session 32
+  added S 25, 51 and 76 mm: ``--spacing``);
 - ``shell0p35``: the same with ``shell_spacing`` 0.35 (p 1.9 mm, packing 12345 only), ``shell0p35/``;
 - ``block45``: the family cases on a block 45 mm long (start, travel and window unchanged; p 1.9 mm, packing 12345
   only), ``block45/``.

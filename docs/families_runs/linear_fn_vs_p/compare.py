@@ -90,6 +90,12 @@ def mean_and_se(values: pd.Series, sems: pd.Series) -> tuple[float, float]:
     return float(v.mean()), float(np.nanmax([scatter, own]))
 
 
+def ratio_and_se(lo: tuple[float, float], hi: tuple[float, float]) -> tuple[float, float]:
+    """The ratio hi / lo of two (mean, s.e.) pairs and its s.e. (the relative errors added in quadrature)."""
+    (m0, e0), (m1, e1) = lo, hi
+    return m1 / m0, abs(m1 / m0) * math.hypot(e0 / m0, e1 / m1)
+
+
 def verdict(ratio: float, se: float) -> str:
     if ratio >= 1.3 and ratio - 2 * se > 1:
         return "rises"
@@ -147,8 +153,7 @@ def ratios(configs: tuple[str, ...] = CONFIGS, spacing: float = 100) -> pd.DataF
             hi = t.loc[PENETRATIONS[1]]
             m0, e0 = mean_and_se(lo[f"{col}_mean_steady"], lo[f"{col}_sem_steady"])
             m1, e1 = mean_and_se(hi[f"{col}_mean_steady"], hi[f"{col}_sem_steady"])
-            ratio = m1 / m0
-            se = abs(ratio) * math.hypot(e0 / m0, e1 / m1)
+            ratio, se = ratio_and_se((m0, e0), (m1, e1))
             own = (hi[f"{col}_mean_steady"] / lo[f"{col}_mean_steady"]).reindex(list(PACKINGS))
             rows.append({"config": c, "force": q, "mean p1.9 N": m0, "se p1.9": e0, "mean p7.6 N": m1, "se p7.6": e1,
                          "ratio 7.6/1.9": ratio, "se": se, "verdict": verdict(ratio, se),
@@ -177,10 +182,8 @@ def by_spacing(configs: tuple[str, ...] = ("family", "shell0p5")) -> pd.DataFram
                     if len(at):
                         stats[s] = mean_and_se(at[f"{col}_mean_steady"], at[f"{col}_sem_steady"])
                         row[f"S{s} N"], row[f"se S{s}"] = stats[s]
-                if 25 in stats and 100 in stats:
-                    (m0, e0), (m1, e1) = stats[25], stats[100]
-                    row["ratio S100/S25"] = m1 / m0
-                    row["se"] = abs(m1 / m0) * math.hypot(e0 / m0, e1 / m1)
+                if SPACINGS[0] in stats and SPACINGS[-1] in stats:
+                    row["ratio S100/S25"], row["se"] = ratio_and_se(stats[SPACINGS[0]], stats[SPACINGS[-1]])
                     row["verdict"] = verdict(row["ratio S100/S25"], row["se"])
                 rows.append(row)
     return pd.DataFrame(rows)
@@ -192,7 +195,7 @@ def matched_trends(config: str = "shell0p5") -> pd.DataFrame:
     from deckgen.families import trend_table
 
     var = pd.read_csv(HERE / config / "family_table.csv")
-    fam = pd.read_csv(FAMILY48)
+    fam = table("family")
     fam = fam[fam["case"].isin(var["variant_case"].str.removesuffix(f"_{config}"))]
     rows = []
     for name, t in (("family", fam), (config, var)):

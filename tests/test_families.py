@@ -1381,6 +1381,55 @@ def test_recorded_rotary_tip4_block40_weakens_the_rolling_force_rise_within_the_
     assert cv.iloc[:, 1].to_list() == pytest.approx([0.39, 0.23, 0.22, 0.30], abs=0.005)
 
 
+def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trends():
+    """docs/families_runs/rotary_shell0p5 (session 33): the family cases at r 250 and 1000 mm on packings 12345, 202, 303
+    and 404 with the finer shell (``shell_spacing`` 0.5) and nothing else, each paired with its family run (same grains
+    and bonds). Unlike the linear block's (x1.65 over 24 pairs) the rotary F_n does not move with the shell: x0.94
+    (95 % interval 0.71-1.24); F_n, F_r and F_r/F_n are flat in r on the finer shell, where the family runs of the same
+    packings show F_r/F_n falling (x0.76 +- 0.07)."""
+    rec = ROOT / "docs" / "families_runs" / "rotary_shell0p5"
+    reduced = ROOT / "cases" / "rotary" / "reduced"
+    names = [f"rot_red_r{r}{k}_shell0p5" for r in (250, 1000) for k in ("", "_k202", "_k303", "_k404")]
+    mod = _docs_script(rec / "compare.py")
+    family, shell = mod.tables()  # raises unless each pair shares its grains and bonds
+    assert sorted(shell["variant_case"]) == sorted(names) and shell["run_completed"].all()
+    for name in names:
+        assert _diagnostic_changes(rec / f"{name}.yaml", reduced / f"{name.removesuffix('_shell0p5')}.yaml") == {
+            ("cutter", "shell_spacing"): (0.5, None)}
+    ratio = shell["n_shell"] / family["n_shell"]
+    assert ratio.min() > 3.8 and ratio.max() < 4.2
+    assert sorted(shell["grains_inside_cutter_final"]) == [0] * 7 + [4]
+    assert sorted(family["grains_inside_cutter_final"]) == [0, 0, 0, 0, 1, 1, 1, 2]
+    t = mod.paired()
+    assert t.loc[(202, 1000), ["F_n N family", "F_n N shell", "F_n sem shell"]].to_list() == pytest.approx(
+        [208.49, 95.54, 27.52], abs=0.01)
+    assert sorted(t["F_n N shell/family"].round(3)) == pytest.approx(
+        [0.458, 0.793, 0.912, 1.007, 1.032, 1.097, 1.215, 1.340], abs=1e-3)
+    g = mod.gains().set_index("pairs")
+    cols = ["runs", "geometric mean", "ci95 low", "ci95 high", "p_value", "above 1"]
+    assert g.loc["rotary F_n", cols].to_list() == pytest.approx([8, 0.941, 0.712, 1.243, 0.621, 5], abs=1e-3)
+    assert g.loc["rotary F_r", cols].to_list() == pytest.approx([8, 1.049, 0.837, 1.315, 0.632, 6], abs=1e-3)
+    assert g.loc["linear F_n", cols].to_list() == pytest.approx([24, 1.654, 1.247, 2.193, 0.001, 20], abs=1e-3)
+    # the rotary interval excludes the linear gain, overall and at p 7.6 mm
+    assert g.loc["rotary F_n", "ci95 high"] < g.loc["linear F_n", "geometric mean"] < g.loc["linear F_n p 7.6", "geometric mean"]
+    r = mod.radius_ratios().set_index(["config", "quantity"])
+    for key, want in {("family", "F_n"): [121.81, 190.03, 1.560, 0.285, "flat"],
+                      ("shell0p5", "F_n"): [137.98, 149.62, 1.084, 0.252, "flat"],
+                      ("family", "F_r/F_n"): [0.451, 0.341, 0.756, 0.069, "falls"],
+                      ("shell0p5", "F_r/F_n"): [0.448, 0.427, 0.952, 0.098, "flat"]}.items():
+        got = r.loc[key, ["r250", "r1000", "r1000/r250", "se"]].to_list()
+        assert got == pytest.approx(want[:4], abs=5e-3), key
+        assert r.loc[key, "verdict"] == want[4], key
+    tr = mod.matched_trends().set_index(["config", "trend"])
+    for key, want in {("family", "fr_fn_falls_with_r"): [8, -0.2437, -0.4178, -0.0264, 0.0352],
+                      ("shell0p5", "fr_fn_falls_with_r"): [8, -0.0480, -0.2596, 0.2220, 0.6458],
+                      ("family", "fn_rises_with_r"): [8, 0.5601, -0.0485, 1.7202, 0.0704],
+                      ("shell0p5", "fn_rises_with_r"): [8, 0.0844, -0.3281, 0.7670, 0.6902]}.items():
+        assert tr.loc[key, ["runs", "change", "ci95 low", "ci95 high", "p_value"]].to_list() == pytest.approx(want, abs=1e-4), key
+    # the seed's F_r/F_n fall (-47 %) lies outside both intervals
+    assert (tr.xs("fr_fn_falls_with_r", level="trend")["ci95 low"] > tr.xs("fr_fn_falls_with_r", level="trend")["seed"]).all()
+
+
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     """docs/families_runs/rotary_block40 (sessions 27-28): packings 606 and 707 at r 250 and 1000 mm on a 40 mm block
     (the chord front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family

@@ -1,0 +1,152 @@
+"""The rotary family on the finer shell (session 33).
+
+Sessions 31-32 found that the default cutter shell (``shell_spacing`` 1: sphere centres 0.6 mm apart on a tip one grain
+wide) leaks grains into the linear disc's tip and that a shell twice as fine (``shell_spacing`` 0.5) about doubles the
+linear F_n. The rotary family uses the same disc and shell. The diagnostics here are the family cases
+``rot_red_r{250,1000}{,_k202,_k303}`` with ``cutter.shell_spacing`` 0.5 and nothing else, so each pairs with the family
+run of the same case (the same grains and bonds; ``../rotary_reduced_7packings/family_table.csv``).
+
+Prints one row per run (family and finer shell side by side, their ratio, grains inside the tip at the end), the
+shell's paired gain in F_n and F_r (geometric mean with its 95 % interval), the
+packing means at r 250 and 1000 mm with their standard errors and the ratio r 1000 / r 250 with its verdict (the rule
+of ``../linear_fn_vs_p/compare.py``: "rises" if >= 1.3 and 2 s.e. above 1, "flat" if 1 lies within 2 s.e.; the
+family's standard errors are the packings' scatter alone, its runs were parsed before the sems existed), and the
+family's rotary trends (:func:`deckgen.families.trend_table`) fitted on the shell runs and on the family runs of the
+same cases.
+
+    python docs/families_runs/rotary_shell0p5/compare.py
+"""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+REPORT = HERE / "report" / "family_table.csv"
+FAMILY = HERE.parent / "rotary_reduced_7packings" / "family_table.csv"
+KEYS = ["packing_seed", "rotary_radius_full_mm"]
+RADII = (250, 1000)  # full-scale mm
+QUANTITIES = {"F_n": "force_normal_N", "F_r": "force_rolling_N", "F_s": "force_side_N"}
+
+
+def _linear_compare():
+    """The packing-mean and ratio rules of the session-31 comparison (one rule for both families)."""
+    path = HERE.parent / "linear_fn_vs_p" / "compare.py"
+    spec = importlib.util.spec_from_file_location("linear_fn_vs_p_compare", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(family, shell): the runs indexed by (packing, r), the family restricted to the cases the shell ran. Raises
+    when a pair does not share its grains and bonds (the shell must be the only change)."""
+    if not REPORT.is_file():
+        raise SystemExit(f"{REPORT}: no report yet (fix: run the shell0p5 diagnostics and report them, docs/families.md,"
+                         " section The rotary family on the finer shell)")
+    shell = pd.read_csv(REPORT).set_index(KEYS).sort_index()
+    family = pd.read_csv(FAMILY).set_index(KEYS).reindex(shell.index)
+    if family["n_grains"].isna().any():
+        raise ValueError(f"{FAMILY}: no family run for {list(shell.index[family['n_grains'].isna()])}")
+    if (family["n_grains"] != shell["n_grains"]).any() or (family["n_bonds_initial"] != shell["n_bonds_initial"]).any():
+        raise ValueError("a shell0p5 run and its family run must share their grains and bonds")
+    return family, shell
+
+
+def paired() -> pd.DataFrame:
+    """One row per (packing, r): each force and F_r/F_n for the family shell and the finer one, and shell/family."""
+    family, shell = tables()
+    out = pd.DataFrame(index=shell.index)
+    cols = {**{f"{q} N": f"{c}_mean_steady" for q, c in QUANTITIES.items()}, "F_r/F_n": "rolling_to_normal_ratio_1"}
+    for name, col in cols.items():
+        out[f"{name} family"], out[f"{name} shell"] = family[col], shell[col]
+        if name != "F_s N":  # a signed force near zero: its ratio is noise
+            out[f"{name} shell/family"] = shell[col] / family[col]
+    out["F_n sem shell"] = shell["force_normal_N_sem_steady"]
+    out["inside family"] = family["grains_inside_cutter_final"]
+    out["inside shell"] = shell["grains_inside_cutter_final"]
+    out["broken family"], out["broken shell"] = family["broken_fraction_1"], shell["broken_fraction_1"]
+    out["n_shell family"], out["n_shell shell"] = family["n_shell"], shell["n_shell"]
+    out["wall_min family"], out["wall_min shell"] = family["wall_s"] / 60, shell["wall_s"] / 60
+    return out
+
+
+def gain_row(label: str, g: np.ndarray) -> dict:
+    """The paired gains ``g`` (shell / family) summarised: geometric mean with its 95 % t interval and the p-value of a
+    one-sample t test of log(g) against 0 (scipy), the median, the range and how many runs the finer shell lifts."""
+    from scipy import stats
+
+    lg = np.log(np.asarray(g, float))
+    n = len(lg)
+    half = stats.t.ppf(0.975, n - 1) * lg.std(ddof=1) / np.sqrt(n)
+    return {"pairs": label, "runs": n, "geometric mean": float(np.exp(lg.mean())),
+            "ci95 low": float(np.exp(lg.mean() - half)), "ci95 high": float(np.exp(lg.mean() + half)),
+            "p_value": float(stats.ttest_1samp(lg, 0.0).pvalue), "median": float(np.median(g)),
+            "min": float(np.min(g)), "max": float(np.max(g)), "above 1": int((np.asarray(g) > 1).sum())}
+
+
+def gains() -> pd.DataFrame:
+    """The shell's gain over the family run of the same case (:func:`gain_row`): rotary F_n and F_r over the pairs
+    here, and for comparison the linear F_n over session 32's 24 pairs and its 12 at p 7.6 mm."""
+    t = paired()
+    lin = _linear_compare()
+    linear = pd.concat([lin.per_run(("shell0p5",), s) for s in lin.SPACINGS])
+    return pd.DataFrame([gain_row("rotary F_n", t["F_n N shell/family"]), gain_row("rotary F_r", t["F_r N shell/family"]),
+                         gain_row("linear F_n", linear["F_n/family"]),
+                         gain_row("linear F_n p 7.6", linear.loc[linear["p_full_mm"] == 7.6, "F_n/family"])])
+
+
+def radius_ratios() -> pd.DataFrame:
+    """Per configuration and quantity: the packing means at r 250 and 1000 mm (± s.e.), their ratio r 1000 / r 250
+    (± s.e.) and its verdict. abs(F_s) per run before the mean (the family trend is on the side force's magnitude)."""
+    lin = _linear_compare()
+    family, shell = tables()
+    rows = []
+    for name, t in (("family", family), ("shell0p5", shell)):
+        for q, c in {**QUANTITIES, "F_r/F_n": None}.items():
+            stats = {}
+            for r in RADII:
+                at = t.xs(r, level="rotary_radius_full_mm")
+                if c is None:
+                    v, s = at["rolling_to_normal_ratio_1"], pd.Series(float("nan"), index=at.index)
+                else:
+                    v = at[f"{c}_mean_steady"].abs() if q == "F_s" else at[f"{c}_mean_steady"]
+                    s = at[f"{c}_sem_steady"] if f"{c}_sem_steady" in at else pd.Series(float("nan"), index=at.index)
+                stats[r] = lin.mean_and_se(v, s)
+            ratio, se = lin.ratio_and_se(stats[RADII[0]], stats[RADII[1]])
+            rows.append({"config": name, "quantity": "abs(F_s)" if q == "F_s" else q,
+                         "r250": stats[250][0], "se r250": stats[250][1], "r1000": stats[1000][0],
+                         "se r1000": stats[1000][1], "r1000/r250": ratio, "se": se, "verdict": lin.verdict(ratio, se)})
+    return pd.DataFrame(rows)
+
+
+def matched_trends() -> pd.DataFrame:
+    """The family's rotary trends fitted on the shell runs and on the family runs of the same cases."""
+    from deckgen.families import trend_table
+
+    family, shell = tables()
+    rows = []
+    for name, t in (("family", family), ("shell0p5", shell)):
+        for _, r in trend_table("rotary", t.reset_index()).iterrows():
+            rows.append({"config": name, "trend": r["trend"], "runs": r["runs"], "change": r["change_1"],
+                         "ci95 low": r["change_1_ci95_low"], "ci95 high": r["change_1_ci95_high"],
+                         "p_value": r["p_value"], "seed": r["seed_change_1"]})
+    return pd.DataFrame(rows)
+
+
+def main() -> None:
+    with pd.option_context("display.width", 220, "display.max_columns", 40):
+        print(paired().round(3).to_string())
+        print()
+        print(gains().round(3).to_string(index=False))
+        print()
+        print(radius_ratios().round(3).to_string(index=False))
+        print()
+        print(matched_trends().round(4).to_string(index=False))
+
+
+if __name__ == "__main__":
+    main()

@@ -1430,6 +1430,24 @@ def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trend
     assert (tr.xs("fr_fn_falls_with_r", level="trend")["ci95 low"] > tr.xs("fr_fn_falls_with_r", level="trend")["seed"]).all()
 
 
+def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
+    """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
+    (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved
+    cut's x1.94 at p 7.6 mm): the grooves do not separate the linear block's shell dependence from the rotary block's;
+    the leak into the coarse shell's tip does (8-14 grains here, 0-2 on the rotary path)."""
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for k in ("", "_k202"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p7p6{k}_unrel_shell0p5.yaml", rec / f"lin_red_s100_p7p6{k}_unrel.yaml") == {
+            ("cutter", "shell_spacing"): (0.5, None)}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "rotary_shell0p5" / "compare.py")
+    u = mod.unrelieved_gain()  # raises unless each pair shares its grains and bonds
+    assert u.loc[[12345, 202], ["F_n coarse N", "F_n fine N", "F_n fine/coarse"]].to_numpy().ravel().tolist() == pytest.approx(
+        [180.887, 465.296, 2.572, 303.831, 451.596, 1.486], abs=1e-3)
+    assert u.loc[[12345, 202], ["inside coarse", "inside fine"]].to_numpy().ravel().tolist() == [8, 4, 14, 2]
+    g = mod.gain_row("unrelieved", u["F_n fine/coarse"])
+    assert g["geometric mean"] == pytest.approx(1.955, abs=1e-3) and g["above 1"] == 2
+
+
 def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     """docs/families_runs/rotary_block40 (sessions 27-28): packings 606 and 707 at r 250 and 1000 mm on a 40 mm block
     (the chord front ends >= 16 mm from the fixed grains instead of 6.9 and 2.2 mm). Reported as variants of the family

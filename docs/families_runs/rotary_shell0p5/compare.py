@@ -12,7 +12,7 @@ packing means at r 250 and 1000 mm with their standard errors and the ratio r 10
 of ``../linear_fn_vs_p/compare.py``: "rises" if >= 1.3 and 2 s.e. above 1, "flat" if 1 lies within 2 s.e.; the
 family's standard errors are the packings' scatter alone, its runs were parsed before the sems existed), and the
 family's rotary trends (:func:`deckgen.families.trend_table`) fitted on the shell runs and on the family runs of the
-same cases.
+same cases; then the finer shell on session 31's unrelieved linear cut (:func:`unrelieved_gain`).
 
     python docs/families_runs/rotary_shell0p5/compare.py
 """
@@ -99,6 +99,29 @@ def gains() -> pd.DataFrame:
                          gain_row("linear F_n p 7.6", linear.loc[linear["p_full_mm"] == 7.6, "F_n/family"])])
 
 
+#: session 33's check on the linear block: session 31's unrelieved S 100 mm cut at p 7.6 mm (no neighbour grooves) with
+#: the finer shell, packings 12345 and 202 (``../linear_fn_vs_p/unrel_shell0p5``)
+UNRELIEVED = HERE.parent / "linear_fn_vs_p"
+
+
+def unrelieved_gain() -> pd.DataFrame:
+    """The finer shell on the unrelieved linear cut: per packing F_n, F_r and grains inside for the coarse shell
+    (``unrel``) and the finer (``unrel_shell0p5``), and F_n shell/coarse; the last row summarises the gains
+    (:func:`gain_row`)."""
+    lin = _linear_compare()
+    coarse, fine = lin.runs("unrel").loc[7.6], lin.runs("unrel_shell0p5").loc[7.6]
+    coarse = coarse.reindex(fine.index)
+    if (coarse["n_grains"] != fine["n_grains"]).any() or (coarse["n_bonds_initial"] != fine["n_bonds_initial"]).any():
+        raise ValueError("an unrel_shell0p5 run and its unrel run must share their grains and bonds")
+    out = pd.DataFrame({"F_n coarse N": coarse["force_normal_N_mean_steady"], "F_n fine N": fine["force_normal_N_mean_steady"],
+                        "F_n sem fine": fine["force_normal_N_sem_steady"], "F_r coarse N": coarse["force_rolling_N_mean_steady"],
+                        "F_r fine N": fine["force_rolling_N_mean_steady"],
+                        "inside coarse": coarse["grains_inside_cutter_final"], "inside fine": fine["grains_inside_cutter_final"],
+                        "wall_min fine": fine["wall_s"] / 60})
+    out["F_n fine/coarse"] = out["F_n fine N"] / out["F_n coarse N"]
+    return out
+
+
 def radius_ratios() -> pd.DataFrame:
     """Per configuration and quantity: the packing means at r 250 and 1000 mm (± s.e.), their ratio r 1000 / r 250
     (± s.e.) and its verdict. abs(F_s) per run before the mean (the family trend is on the side force's magnitude)."""
@@ -146,6 +169,9 @@ def main() -> None:
         print(radius_ratios().round(3).to_string(index=False))
         print()
         print(matched_trends().round(4).to_string(index=False))
+        if (UNRELIEVED / "unrel_shell0p5" / "family_table.csv").is_file():
+            print()
+            print(unrelieved_gain().round(3).to_string())
 
 
 if __name__ == "__main__":

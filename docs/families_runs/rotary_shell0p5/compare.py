@@ -3,7 +3,7 @@
 Sessions 31-32 found that the default cutter shell (``shell_spacing`` 1: sphere centres 0.6 mm apart on a tip one grain
 wide) leaks grains into the linear disc's tip and that a shell twice as fine (``shell_spacing`` 0.5) about doubles the
 linear F_n. The rotary family uses the same disc and shell. The diagnostics here are the family cases
-``rot_red_r{250,1000}{,_k202,_k303}`` with ``cutter.shell_spacing`` 0.5 and nothing else, so each pairs with the family
+``rot_red_r{250,1000}{,_k202,_k303,_k404}`` with ``cutter.shell_spacing`` 0.5 and nothing else, so each pairs with the family
 run of the same case (the same grains and bonds; ``../rotary_reduced_7packings/family_table.csv``).
 
 Prints one row per run (family and finer shell side by side, their ratio, grains inside the tip at the end), the
@@ -18,6 +18,7 @@ same cases; then the finer shell on session 31's unrelieved linear cut (:func:`u
 """
 from __future__ import annotations
 
+import functools
 import importlib.util
 from pathlib import Path
 
@@ -32,13 +33,20 @@ RADII = (250, 1000)  # full-scale mm
 QUANTITIES = {"F_n": "force_normal_N", "F_r": "force_rolling_N", "F_s": "force_side_N"}
 
 
+@functools.cache
 def _linear_compare():
-    """The packing-mean and ratio rules of the session-31 comparison (one rule for both families)."""
+    """The packing-mean and ratio rules of the session-31 comparison (one rule for both families), loaded once."""
     path = HERE.parent / "linear_fn_vs_p" / "compare.py"
     spec = importlib.util.spec_from_file_location("linear_fn_vs_p_compare", path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
+
+
+def _same_grains(a: pd.DataFrame, b: pd.DataFrame, what: str) -> None:
+    """Raise unless each row of ``a`` and ``b`` (same index) has the same grains and bonds: the shell the only change."""
+    if (a["n_grains"] != b["n_grains"]).any() or (a["n_bonds_initial"] != b["n_bonds_initial"]).any():
+        raise ValueError(f"{what} must share their grains and bonds")
 
 
 def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -51,8 +59,7 @@ def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
     family = pd.read_csv(FAMILY).set_index(KEYS).reindex(shell.index)
     if family["n_grains"].isna().any():
         raise ValueError(f"{FAMILY}: no family run for {list(shell.index[family['n_grains'].isna()])}")
-    if (family["n_grains"] != shell["n_grains"]).any() or (family["n_bonds_initial"] != shell["n_bonds_initial"]).any():
-        raise ValueError("a shell0p5 run and its family run must share their grains and bonds")
+    _same_grains(family, shell, "a shell0p5 run and its family run")
     return family, shell
 
 
@@ -106,13 +113,11 @@ UNRELIEVED = HERE.parent / "linear_fn_vs_p"
 
 def unrelieved_gain() -> pd.DataFrame:
     """The finer shell on the unrelieved linear cut: per packing F_n, F_r and grains inside for the coarse shell
-    (``unrel``) and the finer (``unrel_shell0p5``), and F_n shell/coarse; the last row summarises the gains
-    (:func:`gain_row`)."""
+    (``unrel``) and the finer (``unrel_shell0p5``), and F_n fine/coarse (summarise it with :func:`gain_row`)."""
     lin = _linear_compare()
     coarse, fine = lin.runs("unrel").loc[7.6], lin.runs("unrel_shell0p5").loc[7.6]
     coarse = coarse.reindex(fine.index)
-    if (coarse["n_grains"] != fine["n_grains"]).any() or (coarse["n_bonds_initial"] != fine["n_bonds_initial"]).any():
-        raise ValueError("an unrel_shell0p5 run and its unrel run must share their grains and bonds")
+    _same_grains(coarse, fine, "an unrel_shell0p5 run and its unrel run")
     out = pd.DataFrame({"F_n coarse N": coarse["force_normal_N_mean_steady"], "F_n fine N": fine["force_normal_N_mean_steady"],
                         "F_n sem fine": fine["force_normal_N_sem_steady"], "F_r coarse N": coarse["force_rolling_N_mean_steady"],
                         "F_r fine N": fine["force_rolling_N_mean_steady"],

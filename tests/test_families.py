@@ -688,26 +688,48 @@ def test_report_of_variants_carries_the_cutter_surface_and_friction(tmp_path):
     assert list(t["cutter_surface"]) == ["smooth"] and list(t["cutter_friction_1"]) == [0.0]
 
 
+def _spec_only_run(tmp_path, name: str, kinematics: dict, specimen: dict, n_grains: int):
+    """A parsed folder of a variant run with only what the variant columns read: spec.json (its kinematics and block)
+    beside parsed/summary.json."""
+    run = tmp_path / name
+    (run / "parsed").mkdir(parents=True)
+    case = {"name": name, "kinematics": kinematics, "specimen": {"kind": "cutting_block", **specimen}}
+    (run / "spec.json").write_text(json.dumps({"case": case, "derived": {"n_shell": 1000}}))
+    (run / "parsed" / "summary.json").write_text(json.dumps({"case": name, "n_grains": n_grains, "wall_s": 600.0}))
+    return run / "parsed"
+
+
 def test_report_of_variants_carries_the_neighbour_spacing_and_block_height(tmp_path):
     """A linear variant without neighbour grooves (an unrelieved cut) on a taller block keeps its family case's factors
     (S 100 mm) but says what it ran: neighbour_spacing_mm NaN and its own block height; the family case itself, run as a
     variant name, reports its grooves and height."""
     index = str(ROOT / "cases/linear_ccs/index.csv")
-    dirs = []
-    for name, kin, height in (("lin_red_s100_p7p6_unrel_h24", {"mode": "linear", "neighbour_spacing_mm": None}, 24.0),
-                              ("lin_red_s100_p1p9_k202_same", {"mode": "linear", "neighbour_spacing_mm": 12.5}, 12.0)):
-        run = tmp_path / name
-        (run / "parsed").mkdir(parents=True)
-        case = {"name": name, "kinematics": kin, "specimen": {"kind": "cutting_block", "height_mm": height}}
-        (run / "spec.json").write_text(json.dumps({"case": case, "derived": {"n_shell": 1066}}))
-        (run / "parsed" / "summary.json").write_text(json.dumps({"case": name, "n_grains": 2488, "wall_s": 600.0}))
-        dirs.append(run / "parsed")
+    dirs = [_spec_only_run(tmp_path, name, kin, {"height_mm": height}, n_grains=2488)
+            for name, kin, height in (("lin_red_s100_p7p6_unrel_h24", {"mode": "linear", "neighbour_spacing_mm": None}, 24.0),
+                                      ("lin_red_s100_p1p9_k202_same", {"mode": "linear", "neighbour_spacing_mm": 12.5}, 12.0))]
     t = fam.family_table(index, dirs, variants=True).set_index("variant_case")
     unrel, same = t.loc["lin_red_s100_p7p6_unrel_h24"], t.loc["lin_red_s100_p1p9_k202_same"]
     assert (unrel["case"], same["case"]) == ("lin_red_s100_p7p6", "lin_red_s100_p1p9_k202")
     assert unrel["spacing_full_mm"] == same["spacing_full_mm"] == 100
     assert np.isnan(unrel["neighbour_spacing_mm"]) and same["neighbour_spacing_mm"] == 12.5
     assert (unrel["block_height_mm"], same["block_height_mm"]) == (24.0, 12.0)
+
+
+def test_report_of_variants_says_when_a_rotary_case_ran_a_straight_path(tmp_path):
+    """A rotary family case cut along a straight line (session 34's ``*_straight`` diagnostics) keeps its family case's
+    factors (r 3000 mm) but reports kinematics_mode linear and no rotary radius (its resolved case carries the schema's
+    default 250 mm, which means nothing off the rotary path); the rotary variant beside it reports its own radius and
+    block width."""
+    dirs = [_spec_only_run(tmp_path, name, kin, {"width_mm": width}, n_grains=2639)
+            for name, kin, width in (("rot_red_r3000_straight", {"mode": "linear", "rotary_radius_mm": 250.0}, 42.0),
+                                     ("rot_red_r1000_k202_wide", {"mode": "rotary", "rotary_radius_mm": 125.0}, 66.0))]
+    t = fam.family_table(ROOT / "cases/rotary/index.csv", dirs, variants=True).set_index("variant_case")
+    straight, wide = t.loc["rot_red_r3000_straight"], t.loc["rot_red_r1000_k202_wide"]
+    assert (straight["case"], wide["case"]) == ("rot_red_r3000", "rot_red_r1000_k202")
+    assert (straight["rotary_radius_full_mm"], wide["rotary_radius_full_mm"]) == (3000, 1000)  # the family's factor
+    assert (straight["kinematics_mode"], wide["kinematics_mode"]) == ("linear", "rotary")
+    assert np.isnan(straight["rotary_radius_mm"]) and wide["rotary_radius_mm"] == 125.0
+    assert (straight["block_width_mm"], wide["block_width_mm"]) == (42.0, 66.0)
 
 
 def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
@@ -1391,7 +1413,8 @@ def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trend
     reduced = ROOT / "cases" / "rotary" / "reduced"
     names = [f"rot_red_r{r}{k}_shell0p5" for r in (250, 1000) for k in ("", "_k202", "_k303", "_k404")]
     mod = _docs_script(rec / "compare.py")
-    family, shell = mod.tables()  # raises unless each pair shares its grains and bonds
+    s33 = ("report",)  # session 33's four packings (session 34's three more: report_k505_k707)
+    family, shell = mod.tables(s33)  # raises unless each pair shares its grains and bonds
     assert sorted(shell["variant_case"]) == sorted(names) and shell["run_completed"].all()
     for name in names:
         assert _diagnostic_changes(rec / f"{name}.yaml", reduced / f"{name.removesuffix('_shell0p5')}.yaml") == {
@@ -1400,19 +1423,19 @@ def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trend
     assert ratio.min() > 3.8 and ratio.max() < 4.2
     assert sorted(shell["grains_inside_cutter_final"]) == [0] * 7 + [4]
     assert sorted(family["grains_inside_cutter_final"]) == [0, 0, 0, 0, 1, 1, 1, 2]
-    t = mod.paired()
+    t = mod.paired(s33)
     assert t.loc[(202, 1000), ["F_n N family", "F_n N shell", "F_n sem shell"]].to_list() == pytest.approx(
         [208.49, 95.54, 27.52], abs=0.01)
     assert sorted(t["F_n N shell/family"].round(3)) == pytest.approx(
         [0.458, 0.793, 0.912, 1.007, 1.032, 1.097, 1.215, 1.340], abs=1e-3)
-    g = mod.gains().set_index("pairs")
+    g = mod.gains(s33).set_index("pairs")
     cols = ["runs", "geometric mean", "ci95 low", "ci95 high", "p_value", "above 1"]
     assert g.loc["rotary F_n", cols].to_list() == pytest.approx([8, 0.941, 0.712, 1.243, 0.621, 5], abs=1e-3)
     assert g.loc["rotary F_r", cols].to_list() == pytest.approx([8, 1.049, 0.837, 1.315, 0.632, 6], abs=1e-3)
     assert g.loc["linear F_n", cols].to_list() == pytest.approx([24, 1.654, 1.247, 2.193, 0.001, 20], abs=1e-3)
     # the rotary interval excludes the linear gain, overall and at p 7.6 mm
     assert g.loc["rotary F_n", "ci95 high"] < g.loc["linear F_n", "geometric mean"] < g.loc["linear F_n p 7.6", "geometric mean"]
-    r = mod.radius_ratios().set_index(["config", "quantity"])
+    r = mod.radius_ratios(s33).set_index(["config", "quantity"])
     for key, want in {("family", "F_n"): [121.81, 190.03, 1.560, 0.285, "flat"],
                       ("shell0p5", "F_n"): [137.98, 149.62, 1.084, 0.252, "flat"],
                       ("family", "F_r/F_n"): [0.451, 0.341, 0.756, 0.069, "falls"],
@@ -1420,7 +1443,7 @@ def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trend
         got = r.loc[key, ["r250", "r1000", "r1000/r250", "se"]].to_list()
         assert got == pytest.approx(want[:4], abs=5e-3), key
         assert r.loc[key, "verdict"] == want[4], key
-    tr = mod.matched_trends().set_index(["config", "trend"])
+    tr = mod.matched_trends(s33).set_index(["config", "trend"])
     for key, want in {("family", "fr_fn_falls_with_r"): [8, -0.2437, -0.4178, -0.0264, 0.0352],
                       ("shell0p5", "fr_fn_falls_with_r"): [8, -0.0480, -0.2596, 0.2220, 0.6458],
                       ("family", "fn_rises_with_r"): [8, 0.5601, -0.0485, 1.7202, 0.0704],

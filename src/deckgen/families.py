@@ -831,11 +831,15 @@ TABLE_FIELDS = [
 
 #: (column, section of the case, field) a diagnostic variant of a family case may change; ``family_table(variants=True)``
 #: reports them from the run's spec.json (a resolved case leaves some out at their defaults, which come from the spec):
-#: kinematics tokens, the cutter's surface and friction, the neighbour grooves (NaN: an unrelieved cut) and block height.
+#: kinematics tokens, the cutter's surface and friction, the neighbour grooves (NaN: an unrelieved cut), block height and
+#: width, and the path (``kinematics_mode``: a rotary case cut along a straight line reports ``linear`` here and NaN in
+#: ``rotary_radius_mm``, while ``rotary_radius_full_mm`` stays its family case's factor).
 VARIANT_FIELDS = (
     *((token, "kinematics", token) for token in ("spin", "shaft_sense", "penetration_at", "orbit_lift_ratio")),
     ("cutter_surface", "cutter", "surface"), ("cutter_friction_1", "contact", "cutter_friction"),
     ("neighbour_spacing_mm", "kinematics", "neighbour_spacing_mm"), ("block_height_mm", "specimen", "height_mm"),
+    ("block_width_mm", "specimen", "width_mm"), ("kinematics_mode", "kinematics", "mode"),
+    ("rotary_radius_mm", "kinematics", "rotary_radius_mm"),
 )
 
 
@@ -922,6 +926,8 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             models = {"cutter": Cutter, "contact": Contact, "kinematics": Kinematics, "specimen": CuttingBlock}
             row.update({col: spec.get("case", {}).get(sec, {}).get(f, models[sec].model_fields[f].default)
                         for col, sec, f in VARIANT_FIELDS})
+            if row["kinematics_mode"] != "rotary":  # the schema's default radius means nothing off the rotary path
+                row["rotary_radius_mm"] = float("nan")
             s = {**s, "case": _variant_base(s["case"], known, summary)}
         try:
             row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)

@@ -1,10 +1,12 @@
-"""The rotary family on the finer shell (session 33).
+"""The rotary family on the finer shell (sessions 33-34).
 
 Sessions 31-32 found that the default cutter shell (``shell_spacing`` 1: sphere centres 0.6 mm apart on a tip one grain
 wide) leaks grains into the linear disc's tip and that a shell twice as fine (``shell_spacing`` 0.5) about doubles the
 linear F_n. The rotary family uses the same disc and shell. The diagnostics here are the family cases
-``rot_red_r{250,1000}{,_k202,_k303,_k404}`` with ``cutter.shell_spacing`` 0.5 and nothing else, so each pairs with the family
-run of the same case (the same grains and bonds; ``../rotary_reduced_7packings/family_table.csv``).
+``rot_red_r{250,1000}{,_k202,_k303,_k404}`` (session 33, ``report/``) and ``rot_red_r{250,1000}_k{505,606,707}`` (session
+34, ``report_k505_k707/``) with ``cutter.shell_spacing`` 0.5 and nothing else, so each pairs with the family run of the
+same case (the same grains and bonds; ``../rotary_reduced_7packings/family_table.csv``). Every function takes
+``reports``: the report folders to pool (default all of :data:`REPORTS`; ``("report",)`` is session 33's four packings).
 
 Prints one row per run (family and finer shell side by side, their ratio, grains inside the tip at the end), the
 shell's paired gain in F_n and F_r (geometric mean with its 95 % interval), the
@@ -26,7 +28,8 @@ import numpy as np
 import pandas as pd
 
 HERE = Path(__file__).resolve().parent
-REPORT = HERE / "report" / "family_table.csv"
+#: the report folders of the shell0p5 runs, by session: 33 packings 12345, 202, 303, 404; 34 packings 505, 606, 707
+REPORTS = ("report", "report_k505_k707")
 FAMILY = HERE.parent / "rotary_reduced_7packings" / "family_table.csv"
 KEYS = ["packing_seed", "rotary_radius_full_mm"]
 RADII = (250, 1000)  # full-scale mm
@@ -49,13 +52,20 @@ def _same_grains(a: pd.DataFrame, b: pd.DataFrame, what: str) -> None:
         raise ValueError(f"{what} must share their grains and bonds")
 
 
-def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(family, shell): the runs indexed by (packing, r), the family restricted to the cases the shell ran. Raises
-    when a pair does not share its grains and bonds (the shell must be the only change)."""
-    if not REPORT.is_file():
-        raise SystemExit(f"{REPORT}: no report yet (fix: run the shell0p5 diagnostics and report them, docs/families.md,"
-                         " section The rotary family on the finer shell)")
-    shell = pd.read_csv(REPORT).set_index(KEYS).sort_index()
+def tables(reports: tuple[str, ...] = REPORTS) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(family, shell): the runs of the report folders ``reports`` indexed by (packing, r), the family restricted to the
+    cases the shell ran. Raises when a pair does not share its grains and bonds (the shell must be the only change) or
+    when two reports hold the same case."""
+    parts = []
+    for name in reports:
+        path = HERE / name / "family_table.csv"
+        if not path.is_file():
+            raise SystemExit(f"{path}: no report yet (fix: run the shell0p5 diagnostics and report them, docs/families.md,"
+                             " section The rotary family on the finer shell)")
+        parts.append(pd.read_csv(path))
+    shell = pd.concat(parts, ignore_index=True).set_index(KEYS).sort_index()
+    if shell.index.duplicated().any():
+        raise ValueError(f"{reports}: the same (packing, r) in two reports: {list(shell.index[shell.index.duplicated()])}")
     family = pd.read_csv(FAMILY).set_index(KEYS).reindex(shell.index)
     if family["n_grains"].isna().any():
         raise ValueError(f"{FAMILY}: no family run for {list(shell.index[family['n_grains'].isna()])}")
@@ -63,9 +73,9 @@ def tables() -> tuple[pd.DataFrame, pd.DataFrame]:
     return family, shell
 
 
-def paired() -> pd.DataFrame:
+def paired(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
     """One row per (packing, r): each force and F_r/F_n for the family shell and the finer one, and shell/family."""
-    family, shell = tables()
+    family, shell = tables(reports)
     out = pd.DataFrame(index=shell.index)
     cols = {**{f"{q} N": f"{c}_mean_steady" for q, c in QUANTITIES.items()}, "F_r/F_n": "rolling_to_normal_ratio_1"}
     for name, col in cols.items():
@@ -95,10 +105,10 @@ def gain_row(label: str, g: np.ndarray) -> dict:
             "min": float(np.min(g)), "max": float(np.max(g)), "above 1": int((np.asarray(g) > 1).sum())}
 
 
-def gains() -> pd.DataFrame:
+def gains(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
     """The shell's gain over the family run of the same case (:func:`gain_row`): rotary F_n and F_r over the pairs
     here, and for comparison the linear F_n over session 32's 24 pairs and its 12 at p 7.6 mm."""
-    t = paired()
+    t = paired(reports)
     lin = _linear_compare()
     linear = pd.concat([lin.per_run(("shell0p5",), s) for s in lin.SPACINGS])
     return pd.DataFrame([gain_row("rotary F_n", t["F_n N shell/family"]), gain_row("rotary F_r", t["F_r N shell/family"]),
@@ -127,11 +137,11 @@ def unrelieved_gain() -> pd.DataFrame:
     return out
 
 
-def radius_ratios() -> pd.DataFrame:
+def radius_ratios(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
     """Per configuration and quantity: the packing means at r 250 and 1000 mm (± s.e.), their ratio r 1000 / r 250
     (± s.e.) and its verdict. abs(F_s) per run before the mean (the family trend is on the side force's magnitude)."""
     lin = _linear_compare()
-    family, shell = tables()
+    family, shell = tables(reports)
     rows = []
     for name, t in (("family", family), ("shell0p5", shell)):
         for q, c in {**QUANTITIES, "F_r/F_n": None}.items():
@@ -151,11 +161,11 @@ def radius_ratios() -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def matched_trends() -> pd.DataFrame:
+def matched_trends(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
     """The family's rotary trends fitted on the shell runs and on the family runs of the same cases."""
     from deckgen.families import trend_table
 
-    family, shell = tables()
+    family, shell = tables(reports)
     rows = []
     for name, t in (("family", family), ("shell0p5", shell)):
         for _, r in trend_table("rotary", t.reset_index()).iterrows():
@@ -166,14 +176,21 @@ def matched_trends() -> pd.DataFrame:
 
 
 def main() -> None:
+    present = tuple(r for r in REPORTS if (HERE / r / "family_table.csv").is_file()) or REPORTS
     with pd.option_context("display.width", 220, "display.max_columns", 40):
-        print(paired().round(3).to_string())
+        print(f"reports pooled: {', '.join(present)}")
+        print(paired(present).round(3).to_string())
         print()
-        print(gains().round(3).to_string(index=False))
+        print(gains(present).round(3).to_string(index=False))
+        for name in present if len(present) > 1 else ():
+            t = paired((name,))
+            print(pd.DataFrame([gain_row(f"rotary F_n, {name} alone", t["F_n N shell/family"]),
+                                gain_row(f"rotary F_r, {name} alone", t["F_r N shell/family"])]).round(3).to_string(
+                                    index=False, header=False))
         print()
-        print(radius_ratios().round(3).to_string(index=False))
+        print(radius_ratios(present).round(3).to_string(index=False))
         print()
-        print(matched_trends().round(4).to_string(index=False))
+        print(matched_trends(present).round(4).to_string(index=False))
         if (UNRELIEVED / "unrel_shell0p5" / "family_table.csv").is_file():
             print()
             print(unrelieved_gain().round(3).to_string())

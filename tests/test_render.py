@@ -356,3 +356,31 @@ def test_penetration_at_orbit_bottom_lifts_the_orbit_by_e():
     with pytest.raises(ValueError, match="only mode oscillation has an orbit"):
         Case.model_validate({**base.model_dump(), "kinematics": {"mode": "linear", "speed_m_s": 2, "penetration_mm": 4,
                                                                  "travel_mm": 12, "penetration_at": "orbit_bottom"}})
+
+
+@pytest.mark.parametrize("name, kinematics", [
+    ("tiny_cut", None),  # eccentric oscillation, untilted
+    ("tiny_cut", {"mode": "linear", "speed_m_s": 2, "penetration_mm": 1.5, "travel_mm": 3, "spin": "rolling"}),
+    ("tiny_rotary", None),
+])
+def test_every_cutter_path_moves_the_shell_in_all_three_directions(tmp_path, name, kinematics):
+    """``fix move variable`` integrates a component whose displacement and velocity are both NULL from the forces on
+    each atom (as fix nve would): a NULL y let each shell sphere of the straight and eccentric paths drift sideways
+    under the rock's push (session 34). Every branch of the deck now gives all six variables."""
+    import re
+
+    import yaml
+
+    from deckgen.deck import render_case
+    from deckgen.spec import load_case
+
+    regen = _regen()
+    data = yaml.safe_load((ROOT / "tests" / "data" / "cases" / f"{name}.yaml").read_text())
+    if kinematics:
+        data["kinematics"] = kinematics
+    (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data))
+    case = load_case(tmp_path / f"{name}.yaml")
+    regen.install_fixture(case, name, tmp_path / "cache")
+    render_case(case, tmp_path / "run", cache=tmp_path / "cache", progress=False, command=["false"])
+    moves = re.findall(r"^fix\s+move\s+cutter\s+move\s+variable\s+(.*)$", (tmp_path / "run" / "in.deck").read_text(), re.M)
+    assert moves == ["v_dx v_dy v_dz v_vx v_vy v_vz"]

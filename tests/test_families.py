@@ -1453,6 +1453,32 @@ def test_recorded_rotary_finer_shell_leaves_the_force_level_and_the_radius_trend
     assert (tr.xs("fr_fn_falls_with_r", level="trend")["ci95 low"] > tr.xs("fr_fn_falls_with_r", level="trend")["seed"]).all()
 
 
+def test_recorded_rotary_finer_shell_on_packings_505_and_707():
+    """docs/families_runs/rotary_shell0p5/report_k505_k707 (session 34): the finer shell at r 250 mm on the two packings
+    whose family runs have the lowest F_n of the 28 (53.1 and 44.3 N). Both rise (x2.76, x1.49: toward the other
+    packings' level), so over the 10 pairs the rotary gain is x1.10 (95 % interval 0.79-1.53), still containing 1 and
+    below the linear x1.65; the radius ratios keep to the four packings run at both radii."""
+    rec = ROOT / "docs" / "families_runs" / "rotary_shell0p5"
+    reduced = ROOT / "cases" / "rotary" / "reduced"
+    names = [f"rot_red_r{r}_k{k}_shell0p5" for r in (250, 1000) for k in (505, 606, 707)]
+    for name in names:  # all six written; the r 1000 mm and packing 606 ones were not run (session 34 re-ran the linear deck)
+        assert _diagnostic_changes(rec / f"{name}.yaml", reduced / f"{name.removesuffix('_shell0p5')}.yaml") == {
+            ("cutter", "shell_spacing"): (0.5, None)}
+    mod = _docs_script(rec / "compare.py")
+    family, shell = mod.tables(("report_k505_k707",))  # raises unless each pair shares its grains and bonds
+    assert sorted(shell["variant_case"]) == ["rot_red_r250_k505_shell0p5", "rot_red_r250_k707_shell0p5"]
+    assert shell["run_completed"].all() and sorted(shell["grains_inside_cutter_final"]) == [0, 1]
+    t = mod.paired(("report_k505_k707",))
+    assert t[["F_n N family", "F_n N shell", "F_n N shell/family"]].to_numpy().ravel().tolist() == pytest.approx(
+        [53.103, 146.733, 2.763, 44.301, 65.844, 1.486], abs=1e-3)
+    g = mod.gains().set_index("pairs")  # both reports pooled
+    cols = ["runs", "geometric mean", "ci95 low", "ci95 high", "p_value", "above 1"]
+    assert g.loc["rotary F_n", cols].to_list() == pytest.approx([10, 1.097, 0.789, 1.525, 0.541, 7], abs=1e-3)
+    assert g.loc["rotary F_n", "ci95 low"] < 1 < g.loc["rotary F_n", "ci95 high"] < g.loc["linear F_n", "ci95 high"]
+    # the radius ratios and trends pool only packings run at both radii: the same as session 33's four
+    assert mod.radius_ratios().equals(mod.radius_ratios(("report",)))
+
+
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
     """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
     (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved

@@ -137,11 +137,20 @@ def unrelieved_gain() -> pd.DataFrame:
     return out
 
 
+def _both_radii(reports: tuple[str, ...]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`tables` restricted to the packings run at both radii (a packing with one radius would shift one mean)."""
+    family, shell = tables(reports)
+    counts = shell.reset_index().groupby("packing_seed")["rotary_radius_full_mm"].nunique()
+    keep = shell.index.get_level_values("packing_seed").isin(counts.index[counts == len(RADII)])
+    return family[keep], shell[keep]
+
+
 def radius_ratios(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
     """Per configuration and quantity: the packing means at r 250 and 1000 mm (± s.e.), their ratio r 1000 / r 250
-    (± s.e.) and its verdict. abs(F_s) per run before the mean (the family trend is on the side force's magnitude)."""
+    (± s.e.) and its verdict, over the packings run at both radii. abs(F_s) per run before the mean (the family trend
+    is on the side force's magnitude)."""
     lin = _linear_compare()
-    family, shell = tables(reports)
+    family, shell = _both_radii(reports)
     rows = []
     for name, t in (("family", family), ("shell0p5", shell)):
         for q, c in {**QUANTITIES, "F_r/F_n": None}.items():
@@ -162,10 +171,11 @@ def radius_ratios(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
 
 
 def matched_trends(reports: tuple[str, ...] = REPORTS) -> pd.DataFrame:
-    """The family's rotary trends fitted on the shell runs and on the family runs of the same cases."""
+    """The family's rotary trends fitted on the shell runs and on the family runs of the same cases (the packings run at
+    both radii)."""
     from deckgen.families import trend_table
 
-    family, shell = tables(reports)
+    family, shell = _both_radii(reports)
     rows = []
     for name, t in (("family", family), ("shell0p5", shell)):
         for _, r in trend_table("rotary", t.reset_index()).iterrows():

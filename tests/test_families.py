@@ -716,7 +716,7 @@ def test_report_of_variants_carries_the_neighbour_spacing_and_block_height(tmp_p
 
 
 def test_report_of_variants_says_when_a_rotary_case_ran_a_straight_path(tmp_path):
-    """A rotary family case cut along a straight line (session 34's ``*_straight`` diagnostics) keeps its family case's
+    """A rotary family case cut along a straight line keeps its family case's
     factors (r 3000 mm) but reports kinematics_mode linear and no rotary radius (its resolved case carries the schema's
     default 250 mm, which means nothing off the rotary path); the rotary variant beside it reports its own radius and
     block width."""

@@ -679,7 +679,7 @@ def test_the_cutter_shell_moves_rigidly_in_the_reference_cut():
     V x duration along x and nothing along y (session 34: the straight branch of the deck left y NULL in
     ``fix move variable``, so LAMMPS integrated it from the contact forces and the shell spheres of the
     earlier reference drifted up to 1.16 mm sideways, 2 of 586 out of the disc's body), and the body rebuilt by
-    ``grains_inside_cutter`` holds all of them in every frame (docs/families_runs/rotary_straight/leak_timeline.py)."""
+    ``grains_inside_cutter`` holds all of them in every frame (docs/families_runs/shell_held/leak_timeline.py)."""
     import importlib.util
 
     spec = _spec(CUT)
@@ -694,7 +694,7 @@ def test_the_cutter_shell_moves_rigidly_in_the_reference_cut():
     moved = cut["V"] * 42000 * spec["derived"]["dt_s"]  # the last step ends a hair past the 3 mm travel
     assert cut["spin_rate"] == 0.0 and moved == pytest.approx(3e-3, rel=1e-3)
     assert d[:, 0] == pytest.approx(moved, abs=5e-8) and np.abs(d[:, 2]).max() < 1e-12  # 6 digits in the dump
-    path = Path(__file__).parents[1] / "docs" / "families_runs" / "rotary_straight" / "leak_timeline.py"
+    path = Path(__file__).parents[1] / "docs" / "families_runs" / "shell_held" / "leak_timeline.py"
     mod_spec = importlib.util.spec_from_file_location("leak_timeline", path)
     mod = importlib.util.module_from_spec(mod_spec)
     mod_spec.loader.exec_module(mod)

@@ -4,11 +4,11 @@ For each run folder given (a rendered and run cutting case: ``run/spec.json`` an
 ``final.dump.gz`` if the deck wrote one), streams the per-atom dump and prints one row per frame: the step, the travel
 fraction, the grains (type 1) whose centres lie inside the true cutter body (:func:`deckgen.results.grains_inside_cutter`,
 the check behind ``grains_inside_cutter_final``), and as a check of that rebuilt body the fraction of the shell's own
-spheres (type 2) whose centres it holds (they sit their radius inside the surface, so 1.0 unless the rebuild of the
-deck's motion is wrong, as it would be if a rotary path were carried as a straight one). Frames are read one at a time
-(:func:`deckgen.parse.dump.iter_frames`).
+spheres (type 2) whose centres it holds (they sit their radius inside the surface, so 1.0 unless the shell moved other
+than the deck's rigid motion: below 1.0 on the straight-path decks before session 34, whose shell spheres drifted
+sideways; see ``compare.py`` here). Frames are read one at a time (:func:`deckgen.parse.dump.iter_frames`).
 
-    python docs/families_runs/rotary_straight/leak_timeline.py RUN_DIR [RUN_DIR ...] [--csv OUT.csv]
+    python docs/families_runs/shell_held/leak_timeline.py RUN_DIR [RUN_DIR ...] [--csv OUT.csv]
 
 RUN_DIR is the folder holding spec.json and the dumps (``deckgen render --out RUN_DIR``) or its parent with ``run/``.
 """

@@ -1,0 +1,116 @@
+"""Recorded runs against the same cases on the fixed deck, where the cutter's shell is held in y (session 34).
+
+Until session 34 the straight, indentation and untilted eccentric branches of ``templates/lammps/cutting.lmp.j2`` moved
+the shell with ``fix move variable v_dx NULL v_dz v_vx NULL v_vz``. LAMMPS integrates a component whose displacement
+and velocity are both NULL from the force on each atom, so every shell sphere was free to drift sideways under the
+rock's push (the rotary and tilted branches gave all six variables and were right). The runs here are recorded family
+cases (and session 32's finer-shell diagnostics) rendered again after the fix and run unchanged otherwise: the same
+grains and bonds as the recorded run (checked), so each pair differs only in the deck's y motion of the shell.
+
+    python docs/families_runs/shell_held/compare.py
+
+Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
+its 95 % interval (``../rotary_shell0p5/compare.py``'s ``gain_row``); then, where both shells ran on the fixed deck,
+the finer shell's gain over the default one.
+"""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+RUNS = HERE.parent
+#: kind -> (recorded report (old deck), report of the held-shell runs, key column, metrics)
+KINDS = {
+    "linear": (RUNS / "linear_reduced_bpm_granite_replicates_48", HERE / "linear", "case",
+               ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "rolling_to_normal_ratio_1")),
+    "linear shell0p5": (RUNS / "linear_fn_vs_p" / "shell0p5", HERE / "linear_shell0p5", "variant_case",
+                        ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "rolling_to_normal_ratio_1")),
+    "indentation": (RUNS / "indentation_reduced", HERE / "indentation", "case",
+                    ("force_normal_N_peak", "force_side_N_peak", "lateral_to_normal_ratio_1")),
+}
+EXTRA = ("grains_inside_cutter_final", "bonds_broken", "broken_fraction_1", "wall_s")
+
+
+def _gain_row():
+    path = RUNS / "rotary_shell0p5" / "compare.py"
+    spec = importlib.util.spec_from_file_location("rotary_shell0p5_compare", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.gain_row
+
+
+def pairs(kind: str) -> pd.DataFrame:
+    """One row per case of ``kind`` run on the held shell: each metric recorded / held and held / recorded (side
+    forces as they are: a signed peak), grains inside, bonds broken and wall minutes. Raises unless each pair shares
+    its grains and bonds."""
+    old_dir, new_dir, key, metrics = KINDS[kind]
+    new_path = new_dir / "family_table.csv"
+    if not new_path.is_file():
+        raise SystemExit(f"{new_path}: no report yet (fix: run the held-shell re-runs, docs/families.md, section "
+                         "\"The cutter shell held in y\")")
+    new = pd.read_csv(new_path).set_index(key)
+    old = pd.read_csv(old_dir / "family_table.csv").set_index(key).reindex(new.index)
+    if old["n_grains"].isna().any():
+        raise ValueError(f"{old_dir}: no recorded run for {list(new.index[old['n_grains'].isna()])}")
+    if (old["n_grains"] != new["n_grains"]).any() or (old["n_bonds_initial"] != new["n_bonds_initial"]).any():
+        raise ValueError(f"{kind}: a held-shell run does not share its grains and bonds with the recorded run")
+    out = pd.DataFrame(index=new.index)
+    if "packing_seed" in new:
+        out["packing_seed"] = new["packing_seed"]
+    for m in metrics:
+        out[f"{m} recorded"], out[f"{m} held"] = old[m], new[m]
+        out[f"{m} held/recorded"] = new[m] / old[m]
+    for m in EXTRA:
+        out[f"{m} recorded"], out[f"{m} held"] = old[m], new[m]
+    return out
+
+
+def summary(kind: str) -> pd.DataFrame:
+    """Geometric mean of held / recorded per metric (95 % t interval, p of log ratio = 0) over the cases of ``kind``."""
+    gain_row = _gain_row()
+    t = pairs(kind)
+    rows = []
+    for m in KINDS[kind][3]:
+        r = t[f"{m} held/recorded"]
+        if (r > 0).all() and len(r) > 1:
+            rows.append(gain_row(f"{kind}: {m}", r))
+    return pd.DataFrame(rows)
+
+
+def shell_gain() -> pd.DataFrame:
+    """On the fixed deck: the finer shell's F_n, F_r and grains inside beside the default shell's, per packing, and
+    fine / default (the shell dependence that is left once the shell cannot drift)."""
+    coarse, fine = pairs("linear"), pairs("linear shell0p5")
+    fine = fine.set_index("packing_seed")
+    coarse = coarse.set_index("packing_seed").reindex(fine.index)
+    out = pd.DataFrame(index=fine.index)
+    for m in ("force_normal_N_mean_steady", "force_rolling_N_mean_steady"):
+        out[f"{m} default"], out[f"{m} fine"] = coarse[f"{m} held"], fine[f"{m} held"]
+        out[f"{m} fine/default"] = fine[f"{m} held"] / coarse[f"{m} held"]
+        out[f"{m} fine/default recorded"] = fine[f"{m} recorded"] / coarse[f"{m} recorded"]
+    out["inside default"], out["inside fine"] = coarse["grains_inside_cutter_final held"], fine["grains_inside_cutter_final held"]
+    return out
+
+
+def main() -> None:
+    with pd.option_context("display.width", 250, "display.max_columns", 40):
+        for kind in KINDS:
+            if not (KINDS[kind][1] / "family_table.csv").is_file():
+                print(f"{kind}: no held-shell report yet")
+                continue
+            print(f"== {kind}")
+            print(pairs(kind).round(3).T.to_string())
+            s = summary(kind)
+            if len(s):
+                print(s.round(3).to_string(index=False))
+            print()
+        if all((KINDS[k][1] / "family_table.csv").is_file() for k in ("linear", "linear shell0p5")):
+            print("== the finer shell on the fixed deck")
+            print(shell_gain().round(3).T.to_string())
+
+
+if __name__ == "__main__":
+    main()

@@ -1479,6 +1479,34 @@ def test_recorded_rotary_finer_shell_on_packings_505_and_707():
     assert mod.radius_ratios().equals(mod.radius_ratios(("report",)))
 
 
+def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
+    """docs/families_runs/shell_held (session 34): recorded cases rendered again after the straight-path deck held the
+    shell in y, each with the grains and bonds of its recorded run. No grain gets inside a held shell; the concrete
+    indentation lateral/normal triples (0.17-0.21 -> 0.41-0.90; seed 000 about 0.35); the finer shell's linear F_n
+    falls to about a third of its recorded value, and held, the two spacings agree within the chip scatter."""
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    lin, fine = mod.pairs("linear"), mod.pairs("linear shell0p5")  # raise unless each pair shares grains and bonds
+    assert lin["force_normal_N_mean_steady held"].to_list() == pytest.approx([98.736, 256.150], abs=1e-3)
+    assert fine["force_normal_N_mean_steady held"].to_list() == pytest.approx([176.729, 171.638], abs=1e-3)
+    assert fine["force_normal_N_mean_steady held/recorded"].to_list() == pytest.approx([0.308, 0.435], abs=1e-3)
+    assert lin["grains_inside_cutter_final recorded"].to_list() == [12, 14]
+    for t in (lin, fine):
+        assert t["grains_inside_cutter_final held"].le(1).all()
+    g = mod.shell_gain()
+    assert g["force_normal_N_mean_steady fine/default"].to_list() == pytest.approx([1.790, 0.670], abs=1e-3)
+    assert (g["force_normal_N_mean_steady fine/default recorded"] > 1.6).all()
+    ind = mod.pairs("indentation")
+    concrete = ind[ind.index.str.startswith("ind_red_concrete")]
+    assert len(concrete) == 6 and (concrete["grains_inside_cutter_final held"] == 0).all()
+    assert concrete["grains_inside_cutter_final recorded"].between(4, 12).all()
+    assert concrete["lateral_to_normal_ratio_1 recorded"].between(0.16, 0.21).all()
+    assert concrete["lateral_to_normal_ratio_1 held"].between(0.40, 0.91).all()
+    r = mod.load_gain_row()("concrete", concrete["lateral_to_normal_ratio_1 held/recorded"])
+    assert [r["geometric mean"], r["ci95 low"], r["ci95 high"]] == pytest.approx([3.351, 2.280, 4.927], abs=1e-3)
+    r = mod.load_gain_row()("concrete", concrete["force_normal_N_peak held/recorded"])
+    assert [r["geometric mean"], r["ci95 low"], r["ci95 high"]] == pytest.approx([1.386, 1.113, 1.727], abs=1e-3)
+
+
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
     """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
     (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved

@@ -34,7 +34,8 @@ KINDS = {
 EXTRA = ("grains_inside_cutter_final", "bonds_broken", "broken_fraction_1", "wall_s")
 
 
-def _gain_row():
+def load_gain_row():
+    """``gain_row`` of ../rotary_shell0p5/compare.py (geometric mean of paired ratios with its 95 % t interval)."""
     path = RUNS / "rotary_shell0p5" / "compare.py"
     spec = importlib.util.spec_from_file_location("rotary_shell0p5_compare", path)
     mod = importlib.util.module_from_spec(spec)
@@ -70,7 +71,7 @@ def pairs(kind: str) -> pd.DataFrame:
 
 def summary(kind: str) -> pd.DataFrame:
     """Geometric mean of held / recorded per metric (95 % t interval, p of log ratio = 0) over the cases of ``kind``."""
-    gain_row = _gain_row()
+    gain_row = load_gain_row()
     t = pairs(kind)
     rows = []
     for m in KINDS[kind][3]:

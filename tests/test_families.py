@@ -1481,8 +1481,9 @@ def test_recorded_rotary_finer_shell_on_packings_505_and_707():
 
 def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
     """docs/families_runs/shell_held (session 34): recorded cases rendered again after the straight-path deck held the
-    shell in y, each with the grains and bonds of its recorded run. No grain gets inside a held shell; the concrete
-    indentation lateral/normal triples (0.17-0.21 -> 0.41-0.90; seed 000 about 0.35); the finer shell's linear F_n
+    shell in y, each with the grains and bonds of its recorded run. No grain gets inside a held shell; the
+    indentation lateral/normal triples (all 12 cases: 0.15-0.26 -> 0.41-0.90; seed 000 about 0.35) and the peak force
+    no longer rises with t (+79 % -> -7 %); the finer shell's linear F_n
     falls to about a third of its recorded value, and held, the two spacings agree within the chip scatter."""
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     lin, fine = mod.pairs("linear"), mod.pairs("linear shell0p5")  # raise unless each pair shares grains and bonds
@@ -1505,6 +1506,19 @@ def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
     assert [r["geometric mean"], r["ci95 low"], r["ci95 high"]] == pytest.approx([3.351, 2.280, 4.927], abs=1e-3)
     r = mod.load_gain_row()("concrete", concrete["force_normal_N_peak held/recorded"])
     assert [r["geometric mean"], r["ci95 low"], r["ci95 high"]] == pytest.approx([1.386, 1.113, 1.727], abs=1e-3)
+    assert len(ind) == 12 and (ind["grains_inside_cutter_final held"] == 0).all()
+    s = mod.summary("indentation").set_index("pairs")
+    assert s.loc["indentation: lateral_to_normal_ratio_1", ["geometric mean", "ci95 low", "ci95 high"]].to_list() == \
+        pytest.approx([3.449, 2.871, 4.144], abs=1e-3)
+    # the family's t-trend: +79 % (p 0.046) on the drifting shell, gone on the held one; the seed's +100 % excluded
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs"
+    held = pd.read_csv(rec / "shell_held" / "indentation" / "trends.csv").set_index("trend").loc["fn_rises_with_t"]
+    old = pd.read_csv(rec / "indentation_reduced" / "trends.csv").set_index("trend").loc["fn_rises_with_t"]
+    assert old["change_1"] == pytest.approx(0.793, abs=1e-3) and old["p_value"] < 0.05
+    assert [held["runs"], held["change_1"], held["p_value"]] == pytest.approx([12, -0.074, 0.706], abs=1e-3)
+    assert held["change_1_ci95_high"] < held["seed_change_1"] == 1.0
 
 
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():

@@ -1487,10 +1487,16 @@ def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
     falls to about a third of its recorded value, and held, the two spacings agree within the chip scatter."""
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     lin, fine = mod.pairs("linear"), mod.pairs("linear shell0p5")  # raise unless each pair shares grains and bonds
-    assert lin["force_normal_N_mean_steady held"].to_list() == pytest.approx([98.736, 256.150], abs=1e-3)
+    held = lin["force_normal_N_mean_steady held"]
+    assert held[["lin_red_s100_p7p6", "lin_red_s100_p7p6_k202"]].to_list() == pytest.approx([98.736, 256.150], abs=1e-3)
+    assert held[["lin_red_s100_p1p9", "lin_red_s100_p1p9_k202", "lin_red_s25_p1p9", "lin_red_s25_p1p9_k202"]].to_list() == \
+        pytest.approx([295.720, 393.886, 208.390, 72.842], abs=1e-3)
+    # held, F_n at S 100 mm falls from p 1.9 to 7.6 mm on both packings and rises from S 25 to 100 mm at p 1.9 mm
+    assert (held["lin_red_s100_p7p6"] < held["lin_red_s100_p1p9"]) and (held["lin_red_s100_p7p6_k202"] < held["lin_red_s100_p1p9_k202"])
+    assert mod.linear_ratios()["F_n S100/S25 p1.9 held"].to_list() == pytest.approx([5.407, 1.419], abs=1e-3)  # 202, 12345
     assert fine["force_normal_N_mean_steady held"].to_list() == pytest.approx([176.729, 171.638], abs=1e-3)
     assert fine["force_normal_N_mean_steady held/recorded"].to_list() == pytest.approx([0.308, 0.435], abs=1e-3)
-    assert lin["grains_inside_cutter_final recorded"].to_list() == [12, 14]
+    assert lin.loc[["lin_red_s100_p7p6", "lin_red_s100_p7p6_k202"], "grains_inside_cutter_final recorded"].to_list() == [12, 14]
     for t in (lin, fine):
         assert t["grains_inside_cutter_final held"].le(1).all()
     g = mod.shell_gain()

@@ -85,8 +85,8 @@ def shell_gain() -> pd.DataFrame:
     """On the fixed deck: the finer shell's F_n, F_r and grains inside beside the default shell's, per packing, and
     fine / default (the shell dependence that is left once the shell cannot drift)."""
     coarse, fine = pairs("linear"), pairs("linear shell0p5")
+    coarse = coarse.loc[[c.removesuffix("_shell0p5") for c in fine.index]].set_index("packing_seed")
     fine = fine.set_index("packing_seed")
-    coarse = coarse.set_index("packing_seed").reindex(fine.index)
     out = pd.DataFrame(index=fine.index)
     for m in ("force_normal_N_mean_steady", "force_rolling_N_mean_steady"):
         out[f"{m} default"], out[f"{m} fine"] = coarse[f"{m} held"], fine[f"{m} held"]
@@ -94,6 +94,26 @@ def shell_gain() -> pd.DataFrame:
         out[f"{m} fine/default recorded"] = fine[f"{m} recorded"] / coarse[f"{m} recorded"]
     out["inside default"], out["inside fine"] = coarse["grains_inside_cutter_final held"], fine["grains_inside_cutter_final held"]
     return out
+
+
+def linear_ratios() -> pd.DataFrame:
+    """Per packing, the linear family's two trends as ratios of held runs (and of the recorded runs of the same cases):
+    F_n at S 100 / S 25 mm (p 1.9 mm) and F_r/F_n at p 7.6 / 1.9 mm (S 100 mm). NaN where a case was not re-run."""
+    t = pairs("linear")
+    rows = []
+    for k in sorted(set(t["packing_seed"])):
+        suffix = "" if k == 12345 else f"_k{k}"
+        row = {"packing_seed": k}
+        for which in ("recorded", "held"):
+            def get(case, m):
+                name = f"lin_red_{case}{suffix}"
+                return t.loc[name, f"{m} {which}"] if name in t.index else float("nan")
+            row[f"F_n S100/S25 p1.9 {which}"] = (get("s100_p1p9", "force_normal_N_mean_steady")
+                                                  / get("s25_p1p9", "force_normal_N_mean_steady"))
+            row[f"F_r/F_n p7.6/p1.9 S100 {which}"] = (get("s100_p7p6", "rolling_to_normal_ratio_1")
+                                                       / get("s100_p1p9", "rolling_to_normal_ratio_1"))
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing_seed")
 
 
 def main() -> None:
@@ -111,6 +131,9 @@ def main() -> None:
         if all((KINDS[k][1] / "family_table.csv").is_file() for k in ("linear", "linear shell0p5")):
             print("== the finer shell on the fixed deck")
             print(shell_gain().round(3).T.to_string())
+            print()
+            print("== the linear trends as ratios (held and recorded runs of the same cases)")
+            print(linear_ratios().round(3).T.to_string())
 
 
 if __name__ == "__main__":

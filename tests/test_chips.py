@@ -13,6 +13,7 @@ import pytest
 from deckgen.chips import cutter_work, find_chips, groove_area, kinematic_volume
 from deckgen.datafile import read_bonds
 from deckgen.geometry import ccs_disc, v_disc
+from helpers import load_script
 
 RUNS = Path(__file__).resolve().parent / "data" / "runs"
 
@@ -91,17 +92,13 @@ def test_chips_on_the_committed_reference_cut(tmp_path):
 @pytest.mark.engine
 def test_chips_of_a_real_cut(tmp_path):
     """Tiny oscillating cut (golden case, committed packing) run by the engine, then parsed."""
-    import importlib.util
-
     from deckgen.results import parse_run
     from deckgen.runner import engine_available, run_deck
 
     if not engine_available():
         pytest.skip("no LAMMPS binary (run `make setup`)")
     golden = Path(__file__).resolve().parent / "data" / "golden"
-    mod_spec = importlib.util.spec_from_file_location("regenerate", golden / "regenerate.py")
-    regen = importlib.util.module_from_spec(mod_spec)
-    mod_spec.loader.exec_module(regen)
+    regen = load_script(golden / "regenerate.py")
     run = tmp_path / "run"
     regen.render_golden("tiny_cut", run, tmp_path / "cache")
     spec = json.loads((run / "spec.json").read_text())

@@ -18,6 +18,7 @@ import yaml
 from deckgen import families as fam
 from deckgen.deck import cutter_path
 from deckgen.spec import MM, load_case
+from helpers import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
@@ -1218,12 +1219,7 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
 
 def _docs_script(path: Path):
     """Import a script under docs/families_runs (not a package) as a module."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script(path)
 
 
 def _diagnostic_changes(diag_path: Path, base_path: Path | None = None) -> dict:

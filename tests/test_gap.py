@@ -17,6 +17,7 @@ from deckgen.gap.data import flat_case
 from deckgen.gap.fast import K_SIDE, predict_row
 from deckgen.gap.synth import KINDS, make_set, run_battery
 from deckgen.spec import Case, SpecError, load_case
+from helpers import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = ROOT / "tests" / "data" / "cases" / "gap_base.yaml"
@@ -241,16 +242,12 @@ def test_cli_gap_bad_files(tmp_path, capsys):
 def test_dem_switches_change_the_deck(tmp_path):
     """wear flat and tilt change the cutter STL, neighbour spacing removes the neighbours' grooves from the
     block, confinement loads the free side face with s3 * L * H; the default deck has none of them."""
-    import importlib.util
-
     import trimesh
 
     from deckgen.deck import render_case
     from deckgen.spec import MM
 
-    spec_ = importlib.util.spec_from_file_location("regen", ROOT / "tests" / "data" / "golden" / "regenerate.py")
-    regen = importlib.util.module_from_spec(spec_)
-    spec_.loader.exec_module(regen)
+    regen = load_script(ROOT / "tests" / "data" / "golden" / "regenerate.py", "regen")
     case0 = load_case(ROOT / "tests" / "data" / "cases" / "tiny_cut.yaml")
     over = {"cutter": {"wear_flat_mm": 0.8, "tilt_deg": 6.0}, "specimen": {"kind": "cutting_block", "confining_stress_MPa": 4.0},
             "kinematics": {"neighbour_spacing_mm": 3.5}}

@@ -17,6 +17,7 @@ from deckgen.bonds import bpm_coefficients, section
 from deckgen.parse.log import check_log
 from deckgen.parse.series import read_series
 from deckgen.spec import GPA, MPA, load_case
+from helpers import load_script
 
 DATA = Path(__file__).parent / "data"
 BED = DATA / "liggghts" / "tiny_bed_cut.yaml"
@@ -295,12 +296,7 @@ def test_bonded_ucs_runs_on_fork(tmp_path):
 # ------------------------------------------------------------------------------- oscillation, run
 def _install_packing(case, name, cache):
     """The committed packing fixture of golden case ``name`` as ``case``'s cached packing (no engine)."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("regen", DATA / "golden" / "regenerate.py")
-    regen = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(regen)
-    regen.install_fixture(case, name, cache)
+    load_script(DATA / "golden" / "regenerate.py", "regen").install_fixture(case, name, cache)
 
 
 @needs_liggghts

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import math
 from pathlib import Path
@@ -11,16 +10,30 @@ from pathlib import Path
 import pytest
 
 from deckgen.render import DeckError, f_comment, f_num, f_path, f_tok, render
+from helpers import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "data" / "golden"
 
 
 def _regen():
-    spec = importlib.util.spec_from_file_location("regenerate", GOLDEN / "regenerate.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script(GOLDEN / "regenerate.py")
+
+
+def _render_tiny(tmp_path, name: str, edit) -> tuple:
+    """Render the tiny case ``name`` (tests/data/cases) after ``edit(data)`` changes its YAML data, against the
+    committed packing fixture (no engine). Returns (case, spec.json content); the deck is in ``tmp_path / "run"``."""
+    import yaml
+
+    from deckgen.deck import render_case
+    from deckgen.spec import load_case
+
+    data = yaml.safe_load((ROOT / "tests" / "data" / "cases" / f"{name}.yaml").read_text())
+    edit(data)
+    (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data))
+    case = load_case(tmp_path / f"{name}.yaml")
+    _regen().install_fixture(case, name, tmp_path / "cache")
+    return case, render_case(case, tmp_path / "run", cache=tmp_path / "cache", progress=False, command=["false"])
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), "1; shell ls", True, None, [1]])
@@ -205,19 +218,9 @@ def test_near_rock_mask_matches_dense_sampling():
 def test_near_rock_shell_keeps_the_contact_band(tmp_path):
     """tiny_cut with shell_coverage near_rock: fewer spheres, all of them on the lower part of the rolling disc."""
     import numpy as np
-    import yaml
 
-    from deckgen.deck import render_case
-    from deckgen.spec import load_case
-
-    regen = _regen()
-    data = yaml.safe_load((ROOT / "tests" / "data" / "cases" / "tiny_cut.yaml").read_text())
-    data["cutter"]["shell_coverage"] = "near_rock"
-    data["cutter"]["shell_margin_mm"] = 1.0
-    (tmp_path / "tiny_cut.yaml").write_text(yaml.safe_dump(data))
-    case = load_case(tmp_path / "tiny_cut.yaml")
-    regen.install_fixture(case, "tiny_cut", tmp_path / "cache")
-    spec = render_case(case, tmp_path / "run", cache=tmp_path / "cache", progress=False, command=["false"])
+    _, spec = _render_tiny(tmp_path, "tiny_cut", lambda data: data["cutter"].update(shell_coverage="near_rock",
+                                                                                   shell_margin_mm=1.0))
     d = spec["derived"]
     assert d["n_shell"] < 0.9 * d["n_shell_full_cover"]
     lines = (tmp_path / "run" / "specimen.data").read_text().split("Atoms # bpm/sphere")[1].split("Bonds")[0].strip().splitlines()
@@ -369,18 +372,6 @@ def test_every_cutter_path_moves_the_shell_in_all_three_directions(tmp_path, nam
     under the rock's push (session 34). Every branch of the deck now gives all six variables."""
     import re
 
-    import yaml
-
-    from deckgen.deck import render_case
-    from deckgen.spec import load_case
-
-    regen = _regen()
-    data = yaml.safe_load((ROOT / "tests" / "data" / "cases" / f"{name}.yaml").read_text())
-    if kinematics:
-        data["kinematics"] = kinematics
-    (tmp_path / f"{name}.yaml").write_text(yaml.safe_dump(data))
-    case = load_case(tmp_path / f"{name}.yaml")
-    regen.install_fixture(case, name, tmp_path / "cache")
-    render_case(case, tmp_path / "run", cache=tmp_path / "cache", progress=False, command=["false"])
+    _render_tiny(tmp_path, name, lambda data: data.update(kinematics=kinematics or data["kinematics"]))
     moves = re.findall(r"^fix\s+move\s+cutter\s+move\s+variable\s+(.*)$", (tmp_path / "run" / "in.deck").read_text(), re.M)
     assert moves == ["v_dx v_dy v_dz v_vx v_vy v_vz"]

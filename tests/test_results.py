@@ -24,6 +24,7 @@ import pytest
 from deckgen.parse import ParseError, TruncatedError, iter_frames, read_dump_table, read_series
 from deckgen.plots import plot_run
 from deckgen.results import STAT_SUFFIXES, UNIT_SUFFIXES, UNITLESS_COLUMNS, aggregate, parse_run
+from helpers import load_script
 
 RUNS = Path(__file__).parent / "data" / "runs"
 UCS = RUNS / "ref_ucs"
@@ -680,8 +681,6 @@ def test_the_cutter_shell_moves_rigidly_in_the_reference_cut():
     ``fix move variable``, so LAMMPS integrated it from the contact forces and the shell spheres of the
     earlier reference drifted up to 1.16 mm sideways, 2 of 586 out of the disc's body), and the body rebuilt by
     ``grains_inside_cutter`` holds all of them in every frame (docs/families_runs/shell_held/leak_timeline.py)."""
-    import importlib.util
-
     spec = _spec(CUT)
     cut = spec["derived"]["cutter"]
     first = next(iter_frames(CUT / "atoms.dump.gz", ["id", "type", "x", "y", "z"])).data
@@ -695,10 +694,7 @@ def test_the_cutter_shell_moves_rigidly_in_the_reference_cut():
     assert cut["spin_rate"] == 0.0 and moved == pytest.approx(3e-3, rel=1e-3)
     assert d[:, 0] == pytest.approx(moved, abs=5e-8) and np.abs(d[:, 2]).max() < 1e-12  # 6 digits in the dump
     path = Path(__file__).parents[1] / "docs" / "families_runs" / "shell_held" / "leak_timeline.py"
-    mod_spec = importlib.util.spec_from_file_location("leak_timeline", path)
-    mod = importlib.util.module_from_spec(mod_spec)
-    mod_spec.loader.exec_module(mod)
-    t = mod.timeline(CUT)
+    t = load_script(path).timeline(CUT)
     assert list(t["step"]) == [0, 42000] and list(t["grains_inside"]) == [0, 0]
     assert (t["shell_inside_fraction_1"] == 1.0).all()
     assert t["travel_fraction_1"].iloc[-1] == pytest.approx(1.0)

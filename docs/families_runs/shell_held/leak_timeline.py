@@ -36,9 +36,9 @@ def timeline(run: Path) -> pd.DataFrame:
     if not spec_path.is_file():
         raise SystemExit(f"{run}: no spec.json (fix: give a folder made by deckgen render)")
     spec = json.loads(spec_path.read_text())
-    dt = float(spec["derived"]["dt_s"]) if "dt_s" in spec["derived"] else None
-    if dt is None:
+    if "dt_s" not in spec["derived"]:
         raise SystemExit(f"{spec_path}: derived.dt_s missing (fix: render the case again with this deckgen)")
+    dt = float(spec["derived"]["dt_s"])
     duration = float(spec["derived"]["cutter"]["duration"])
     rows = []
     for name in ("atoms.dump.gz", "final.dump.gz"):

@@ -1523,6 +1523,56 @@ def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
     assert held["change_1_ci95_high"] < held["seed_change_1"] == 1.0
 
 
+def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
+    """docs/families_runs/shell_held/linear (sessions 34-35): 22 linear family cases rendered again on the held deck
+    (every (S, p) of packing 12345, six of 202), each with the grains and bonds of its recorded run. No grain gets
+    inside (0-1 against 0-14); F_n moves case by case (x0.32-4.1) with no mean shift, shallow cuts gaining and deep
+    ones losing; both trends keep their sign (F_n with S p 0.0003; F_r/F_n with p p 0.043), but in seed 001's eq. 7
+    form F_n now falls with p (-55 N/mm, p 0.002; recorded runs of the same cases +9 N/mm, p 0.54; seed 001 rises).
+    Neither the neighbour grooves (unrelieved: x0.48 and x0.44 from p 1.9 to 7.6 mm) nor the fixed end face (45 mm
+    block: x0.52) turns the fall round."""
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    lin = mod.pairs("linear")  # raises unless each pair shares its grains and bonds
+    assert len(lin) == 22 and (lin["packing_seed"] == 12345).sum() == 16
+    assert lin["grains_inside_cutter_final held"].le(1).all() and lin["grains_inside_cutter_final recorded"].max() == 14
+    r = lin["force_normal_N_mean_steady held/recorded"]
+    assert [r.min(), r.max()] == pytest.approx([0.320, 4.101], abs=1e-3)
+    s = mod.summary("linear").set_index("pairs").loc["linear: force_normal_N_mean_steady"]
+    assert [s["geometric mean"], s["ci95 low"], s["ci95 high"]] == pytest.approx([0.896, 0.649, 1.237], abs=1e-3)
+    # packing 12345: shallow cuts gain, deep ones lose (geometric mean of held / recorded per p)
+    k = lin[lin["packing_seed"] == 12345]
+    by_p = {p: float(np.exp(np.log(k.loc[[c for c in k.index if f"_p{p}" in c], "force_normal_N_mean_steady held/recorded"]).mean()))
+            for p in ("1p9", "3p8", "6p4", "7p6")}
+    assert list(by_p.values()) == pytest.approx([2.196, 1.195, 0.549, 0.551], abs=1e-3)
+    reg = mod.regression_same_cases().loc["force_normal_N_mean_steady"]
+    assert reg.loc["penetration_mm", ["held estimate", "recorded estimate"]].to_list() == pytest.approx([-55.389, 8.743], abs=1e-3)
+    assert reg.loc["penetration_mm", "held p_value"] < 0.01 < 0.5 < reg.loc["penetration_mm", "recorded p_value"]
+    assert reg.loc["spacing_mm", "held estimate"] == pytest.approx(20.305, abs=1e-3) and reg.loc["spacing_mm", "held p_value"] < 0.001
+    tr = mod.trends_same_cases("linear")
+    assert tr.loc["fn_rises_with_s", "held p_value"] < 0.001
+    assert tr.loc["fr_fn_rises_with_p", ["held change_1", "held p_value", "recorded change_1", "recorded p_value"]].to_list() == \
+        pytest.approx([1.497, 0.043, 0.680, 0.023], abs=1e-3)
+    # session 31 read the neighbour grooves as what flattens F_n's rise with p; held, the unrelieved cut falls as well
+    fp = mod.fn_p_ratio()
+    assert fp.loc[[202, 12345], "unrelieved recorded p7.6/p1.9"].to_list() == pytest.approx([2.717, 1.099], abs=1e-3)
+    assert fp.loc[[202, 12345], "unrelieved held p7.6/p1.9"].to_list() == pytest.approx([0.477, 0.442], abs=1e-3)
+    assert fp.loc[[202, 12345], "grooved held p7.6/p1.9"].to_list() == pytest.approx([0.650, 0.334], abs=1e-3)
+    assert mod.pairs("linear unrelieved")["grains_inside_cutter_final held"].eq(0).all()
+    # the 45 mm block (fixed end face 19 mm further from the window): p 1.9 mm loses x0.61, p 7.6 mm keeps its force
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    reduced = ROOT / "cases" / "linear_ccs" / "reduced"
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_block45.yaml", reduced / f"lin_red_s100_p{p}.yaml") == {
+            ("specimen", "length_mm"): (45, 26)}
+    b = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_block45" / "family_table.csv").set_index("variant_case")
+    fn = b["force_normal_N_mean_steady"]
+    assert fn[["lin_red_s100_p1p9_block45", "lin_red_s100_p7p6_block45"]].to_list() == pytest.approx([180.331, 94.541], abs=1e-3)
+    assert fn["lin_red_s100_p1p9_block45"] / lin.loc["lin_red_s100_p1p9", "force_normal_N_mean_steady held"] == pytest.approx(0.610, abs=1e-3)
+    assert fn["lin_red_s100_p7p6_block45"] / fn["lin_red_s100_p1p9_block45"] == pytest.approx(0.524, abs=1e-3)
+
+
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
     """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
     (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved

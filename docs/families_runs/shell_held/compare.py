@@ -4,14 +4,17 @@ Until session 34 the straight, indentation and untilted eccentric branches of ``
 the shell with ``fix move variable v_dx NULL v_dz v_vx NULL v_vz``. LAMMPS integrates a component whose displacement
 and velocity are both NULL from the force on each atom, so every shell sphere was free to drift sideways under the
 rock's push (the rotary and tilted branches gave all six variables and were right). The runs here are recorded family
-cases (and session 32's finer-shell diagnostics) rendered again after the fix and run unchanged otherwise: the same
-grains and bonds as the recorded run (checked), so each pair differs only in the deck's y motion of the shell.
+cases (and session 32's finer-shell and session 31's unrelieved diagnostics) rendered again after the fix and run
+unchanged otherwise: the same grains and bonds as the recorded run (checked), so each pair differs only in the deck's y
+motion of the shell. Session 35 added 16 linear family cases (22 in ``linear``), the unrelieved pairs and the 45 mm
+block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair with).
 
     python docs/families_runs/shell_held/compare.py
 
 Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
 its 95 % interval (``../rotary_shell0p5/compare.py``'s ``gain_row``); then, where both shells ran on the fixed deck,
-the finer shell's gain over the default one.
+the finer shell's gain over the default one; F_n at p 7.6 / 1.9 mm with and without the neighbour grooves; seed 001's
+eq. 7 form and the family's trends on the held runs beside the recorded runs of the same cases.
 """
 from __future__ import annotations
 
@@ -28,6 +31,8 @@ KINDS = {
                ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "rolling_to_normal_ratio_1")),
     "linear shell0p5": (RUNS / "linear_fn_vs_p" / "shell0p5", HERE / "linear_shell0p5", "variant_case",
                         ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "rolling_to_normal_ratio_1")),
+    "linear unrelieved": (RUNS / "linear_fn_vs_p" / "unrel", HERE / "linear_unrel", "variant_case",
+                          ("force_normal_N_mean_steady", "force_rolling_N_mean_steady", "rolling_to_normal_ratio_1")),
     "indentation": (RUNS / "indentation_reduced", HERE / "indentation", "case",
                     ("force_normal_N_peak", "force_side_N_peak", "lateral_to_normal_ratio_1")),
 }
@@ -116,6 +121,60 @@ def linear_ratios() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("packing_seed")
 
 
+def trends_same_cases(kind: str = "linear") -> pd.DataFrame:
+    """The family's trends (``deckgen.families.trend_table``, the report's own fit) on the held runs of ``kind`` and on
+    the recorded runs of the same cases, side by side: runs, change over the seed's range with its 95 % interval, p."""
+    from deckgen.families import trend_table
+
+    family = {"linear": "linear_ccs", "indentation": "indentation_asymmetric"}[kind]
+    old_dir, new_dir, key, _ = KINDS[kind]
+    new = pd.read_csv(new_dir / "family_table.csv")
+    old = pd.read_csv(old_dir / "family_table.csv")
+    old = old[old[key].isin(new[key])]
+    cols = ["runs", "groups", "change_1", "change_1_ci95_low", "change_1_ci95_high", "p_value", "seed_change_1"]
+    out = []
+    for which, table in (("recorded", old), ("held", new)):
+        t = trend_table(family, table).set_index("trend")[cols]
+        out.append(t.add_prefix(f"{which} "))
+    return pd.concat(out, axis=1)
+
+
+def regression_same_cases() -> pd.DataFrame:
+    """Seed 001's eq. 7 form (``deckgen.families.family_regression``: Y = b0 + b1 S + b2 p, reduced mm) fitted on the
+    held linear runs and on the recorded runs of the same cases: estimate, standard error, p and R^2 per term."""
+    from deckgen.families import family_regression
+
+    old_dir, new_dir, key, _ = KINDS["linear"]
+    new = pd.read_csv(new_dir / "family_table.csv")
+    old = pd.read_csv(old_dir / "family_table.csv")
+    old = old[old[key].isin(new[key])]
+    cols = ["estimate", "std_error", "p_value", "r_squared", "n_runs"]
+    out = []
+    for which, table in (("recorded", old), ("held", new)):
+        r = family_regression("linear_ccs", table).set_index(["response", "term"])[cols]
+        out.append(r.add_prefix(f"{which} "))
+    return pd.concat(out, axis=1)
+
+
+def fn_p_ratio() -> pd.DataFrame:
+    """F_n at p 7.6 / p 1.9 mm at S 100 mm per packing, with the neighbour grooves (the family cases) and without them
+    (session 31's unrelieved diagnostics), recorded and held: session 31 read the grooves as what flattens the rise."""
+    grooved, unrel = pairs("linear"), pairs("linear unrelieved")
+    m = "force_normal_N_mean_steady"
+    rows = []
+    for k in sorted(set(unrel["packing_seed"])):
+        suffix = "" if k == 12345 else f"_k{k}"
+        row = {"packing_seed": k}
+        for label, t, tail in (("grooved", grooved, ""), ("unrelieved", unrel, "_unrel")):
+            for which in ("recorded", "held"):
+                lo, hi = (t.loc[f"lin_red_s100_p{p}{suffix}{tail}", f"{m} {which}"] if f"lin_red_s100_p{p}{suffix}{tail}" in t.index
+                          else float("nan") for p in ("1p9", "7p6"))
+                row[f"{label} {which} p1.9 N"], row[f"{label} {which} p7.6 N"] = lo, hi
+                row[f"{label} {which} p7.6/p1.9"] = hi / lo
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing_seed")
+
+
 def main() -> None:
     with pd.option_context("display.width", 250, "display.max_columns", 40):
         for kind in KINDS:
@@ -134,6 +193,19 @@ def main() -> None:
             print()
             print("== the linear trends as ratios (held and recorded runs of the same cases)")
             print(linear_ratios().round(3).T.to_string())
+        if all((KINDS[k][1] / "family_table.csv").is_file() for k in ("linear", "linear unrelieved")):
+            print()
+            print("== F_n p 7.6 / p 1.9 mm at S 100 mm, with and without the neighbour grooves")
+            print(fn_p_ratio().round(3).T.to_string())
+        if (KINDS["linear"][1] / "family_table.csv").is_file():
+            print()
+            print("== seed 001's eq. 7 form on the held linear runs and the recorded runs of the same cases")
+            print(regression_same_cases().round(4).to_string())
+        for kind in ("linear", "indentation"):
+            if (KINDS[kind][1] / "family_table.csv").is_file():
+                print()
+                print(f"== the {kind} family's trends, recorded and held runs of the same cases")
+                print(trends_same_cases(kind).round(3).T.to_string())
 
 
 if __name__ == "__main__":

@@ -1529,8 +1529,8 @@ def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
     inside (0-1 against 0-14); F_n moves case by case (x0.32-4.1) with no mean shift, shallow cuts gaining and deep
     ones losing; both trends keep their sign (F_n with S p 0.0003; F_r/F_n with p p 0.043), but in seed 001's eq. 7
     form F_n now falls with p (-55 N/mm, p 0.002; recorded runs of the same cases +9 N/mm, p 0.54; seed 001 rises).
-    Neither the neighbour grooves (unrelieved: x0.48 and x0.44 from p 1.9 to 7.6 mm) nor the fixed end face (45 mm
-    block: x0.52) turns the fall round."""
+    Neither the neighbour grooves (unrelieved: x0.48 and x0.44 from p 1.9 to 7.6 mm), the fixed end face (45 mm
+    block: x0.52) nor the block height (24 mm: x0.49) turns the fall round."""
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     lin = mod.pairs("linear")  # raises unless each pair shares its grains and bonds
     assert len(lin) == 22 and (lin["packing_seed"] == 12345).sum() == 16
@@ -1571,6 +1571,17 @@ def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
     assert fn[["lin_red_s100_p1p9_block45", "lin_red_s100_p7p6_block45"]].to_list() == pytest.approx([180.331, 94.541], abs=1e-3)
     assert fn["lin_red_s100_p1p9_block45"] / lin.loc["lin_red_s100_p1p9", "force_normal_N_mean_steady held"] == pytest.approx(0.610, abs=1e-3)
     assert fn["lin_red_s100_p7p6_block45"] / fn["lin_red_s100_p1p9_block45"] == pytest.approx(0.524, abs=1e-3)
+    # a block 24 mm high: more force at both depths (the 12 mm block gives way under the deep cut), still falling with p
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_h24.yaml", reduced / f"lin_red_s100_p{p}.yaml") == {
+            ("specimen", "height_mm"): (24, 12)}
+    h = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_h24" / "family_table.csv").set_index("variant_case")
+    fn = h["force_normal_N_mean_steady"]
+    assert fn[["lin_red_s100_p1p9_h24", "lin_red_s100_p7p6_h24"]].to_list() == pytest.approx([460.524, 225.187], abs=1e-3)
+    assert (fn / lin.loc[["lin_red_s100_p1p9", "lin_red_s100_p7p6"], "force_normal_N_mean_steady held"].to_numpy()).to_list() == \
+        pytest.approx([1.557, 2.281], abs=1e-3)
+    assert fn["lin_red_s100_p7p6_h24"] / fn["lin_red_s100_p1p9_h24"] == pytest.approx(0.489, abs=1e-3)
+    assert h["grains_inside_cutter_final"].eq(0).all()
 
 
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():

@@ -7,7 +7,8 @@ rock's push (the rotary and tilted branches gave all six variables and were righ
 cases (and session 32's finer-shell and session 31's unrelieved diagnostics) rendered again after the fix and run
 unchanged otherwise: the same grains and bonds as the recorded run (checked), so each pair differs only in the deck's y
 motion of the shell. Session 35 added 16 linear family cases (22 in ``linear``), the unrelieved pairs and the 45 mm
-block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair with).
+block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair with) and a 24 mm high block
+(``linear_h24``, new).
 
     python docs/families_runs/shell_held/compare.py
 

@@ -1558,30 +1558,33 @@ def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
     assert fp.loc[[202, 12345], "unrelieved held p7.6/p1.9"].to_list() == pytest.approx([0.477, 0.442], abs=1e-3)
     assert fp.loc[[202, 12345], "grooved held p7.6/p1.9"].to_list() == pytest.approx([0.650, 0.334], abs=1e-3)
     assert mod.pairs("linear unrelieved")["grains_inside_cutter_final held"].eq(0).all()
-    # the 45 mm block (fixed end face 19 mm further from the window): p 1.9 mm loses x0.61, p 7.6 mm keeps its force
+    held = lin.loc[["lin_red_s100_p1p9", "lin_red_s100_p7p6"], "force_normal_N_mean_steady held"].to_numpy()
+    # block 45 mm long (fixed end face 19 mm further from the window): p 1.9 mm loses x0.61, p 7.6 mm keeps its force;
+    # block 24 mm high: more force at both depths (the 12 mm block gives way under the deep cut); both still fall with p
+    for suffix, field, change, fn_N, of_family, fall in (
+            ("block45", "length_mm", (45, 26), [180.331, 94.541], [0.610, 0.958], 0.524),
+            ("h24", "height_mm", (24, 12), [460.524, 225.187], [1.557, 2.281], 0.489)):
+        t = _held_block_diagnostic(suffix, field, change)
+        fn = t["force_normal_N_mean_steady"].to_numpy()
+        assert fn.tolist() == pytest.approx(fn_N, abs=1e-3)
+        assert (fn / held).tolist() == pytest.approx(of_family, abs=1e-3)
+        assert fn[1] / fn[0] == pytest.approx(fall, abs=1e-3)
+        assert t["grains_inside_cutter_final"].le(2).all()
+
+
+def _held_block_diagnostic(suffix: str, field: str, change: tuple):
+    """The held runs of ``lin_red_s100_p{1p9,7p6}_<suffix>.yaml`` (docs/families_runs/linear_fn_vs_p), each checked to
+    differ from its family case in ``specimen.<field>`` alone: their report rows (shell_held/linear_<suffix>), p 1.9
+    then p 7.6 mm."""
     import pandas as pd
 
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    reduced = ROOT / "cases" / "linear_ccs" / "reduced"
-    for p in ("1p9", "7p6"):
-        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_block45.yaml", reduced / f"lin_red_s100_p{p}.yaml") == {
-            ("specimen", "length_mm"): (45, 26)}
-    b = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_block45" / "family_table.csv").set_index("variant_case")
-    fn = b["force_normal_N_mean_steady"]
-    assert fn[["lin_red_s100_p1p9_block45", "lin_red_s100_p7p6_block45"]].to_list() == pytest.approx([180.331, 94.541], abs=1e-3)
-    assert fn["lin_red_s100_p1p9_block45"] / lin.loc["lin_red_s100_p1p9", "force_normal_N_mean_steady held"] == pytest.approx(0.610, abs=1e-3)
-    assert fn["lin_red_s100_p7p6_block45"] / fn["lin_red_s100_p1p9_block45"] == pytest.approx(0.524, abs=1e-3)
-    # a block 24 mm high: more force at both depths (the 12 mm block gives way under the deep cut), still falling with p
-    for p in ("1p9", "7p6"):
-        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_h24.yaml", reduced / f"lin_red_s100_p{p}.yaml") == {
-            ("specimen", "height_mm"): (24, 12)}
-    h = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_h24" / "family_table.csv").set_index("variant_case")
-    fn = h["force_normal_N_mean_steady"]
-    assert fn[["lin_red_s100_p1p9_h24", "lin_red_s100_p7p6_h24"]].to_list() == pytest.approx([460.524, 225.187], abs=1e-3)
-    assert (fn / lin.loc[["lin_red_s100_p1p9", "lin_red_s100_p7p6"], "force_normal_N_mean_steady held"].to_numpy()).to_list() == \
-        pytest.approx([1.557, 2.281], abs=1e-3)
-    assert fn["lin_red_s100_p7p6_h24"] / fn["lin_red_s100_p1p9_h24"] == pytest.approx(0.489, abs=1e-3)
-    assert h["grains_inside_cutter_final"].eq(0).all()
+    names = [f"lin_red_s100_p{p}" for p in ("1p9", "7p6")]
+    for n in names:
+        assert _diagnostic_changes(rec / f"{n}_{suffix}.yaml", ROOT / "cases" / "linear_ccs" / "reduced" / f"{n}.yaml") == {
+            ("specimen", field): change}
+    table = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / f"linear_{suffix}" / "family_table.csv")
+    return table.set_index("variant_case").loc[[f"{n}_{suffix}" for n in names]]
 
 
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():

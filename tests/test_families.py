@@ -1548,6 +1548,9 @@ def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
     assert reg.loc["penetration_mm", ["held estimate", "recorded estimate"]].to_list() == pytest.approx([-55.389, 8.743], abs=1e-3)
     assert reg.loc["penetration_mm", "held p_value"] < 0.01 < 0.5 < reg.loc["penetration_mm", "recorded p_value"]
     assert reg.loc["spacing_mm", "held estimate"] == pytest.approx(20.305, abs=1e-3) and reg.loc["spacing_mm", "held p_value"] < 0.001
+    # without the p 1.9 mm cells (half a grain deep at reduced scale) the fall keeps its size: not a grain-scale artefact
+    deep = mod.regression_same_cases(2.0).loc[("force_normal_N_mean_steady", "penetration_mm")]
+    assert deep[["held estimate", "held p_value", "held n_runs"]].to_list() == pytest.approx([-53.499, 0.063, 16], abs=1e-3)
     tr = mod.trends_same_cases("linear")
     assert tr.loc["fn_rises_with_s", "held p_value"] < 0.001
     assert tr.loc["fr_fn_rises_with_p", ["held change_1", "held p_value", "recorded change_1", "recorded p_value"]].to_list() == \

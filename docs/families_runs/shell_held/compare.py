@@ -49,6 +49,32 @@ def load_gain_row():
     return mod.gain_row
 
 
+def _has(kind: str) -> bool:
+    """Whether the held-shell report of ``kind`` exists."""
+    return (KINDS[kind][1] / "family_table.csv").is_file()
+
+
+def _case(base: str, packing: int, tail: str = "") -> str:
+    """The case name of ``base`` (e.g. ``lin_red_s100_p1p9``) on ``packing``: the default packing 12345 has no suffix."""
+    return f"{base}{'' if packing == 12345 else f'_k{packing}'}{tail}"
+
+
+def _value(t: pd.DataFrame, name: str, col: str) -> float:
+    """``t.loc[name, col]``, NaN where the case was not re-run."""
+    return t.loc[name, col] if name in t.index else float("nan")
+
+
+def _same_case_tables(kind: str, min_p_full_mm: float = 0.0) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(recorded, held) report tables of ``kind``, the recorded one cut to the held cases; only cases with a full-scale
+    p above ``min_p_full_mm`` (the indentation family has no p: leave 0)."""
+    old_dir, new_dir, key, _ = KINDS[kind]
+    new = pd.read_csv(new_dir / "family_table.csv")
+    if min_p_full_mm:
+        new = new[new["penetration_full_mm"] > min_p_full_mm]
+    old = pd.read_csv(old_dir / "family_table.csv")
+    return old[old[key].isin(new[key])], new
+
+
 def pairs(kind: str) -> pd.DataFrame:
     """One row per case of ``kind`` run on the held shell: each metric recorded / held and held / recorded (side
     forces as they are: a signed peak), grains inside, bonds broken and wall minutes. Raises unless each pair shares
@@ -108,16 +134,13 @@ def linear_ratios() -> pd.DataFrame:
     t = pairs("linear")
     rows = []
     for k in sorted(set(t["packing_seed"])):
-        suffix = "" if k == 12345 else f"_k{k}"
         row = {"packing_seed": k}
         for which in ("recorded", "held"):
-            def get(case, m):
-                name = f"lin_red_{case}{suffix}"
-                return t.loc[name, f"{m} {which}"] if name in t.index else float("nan")
-            row[f"F_n S100/S25 p1.9 {which}"] = (get("s100_p1p9", "force_normal_N_mean_steady")
-                                                  / get("s25_p1p9", "force_normal_N_mean_steady"))
-            row[f"F_r/F_n p7.6/p1.9 S100 {which}"] = (get("s100_p7p6", "rolling_to_normal_ratio_1")
-                                                       / get("s100_p1p9", "rolling_to_normal_ratio_1"))
+            fn, frfn = f"force_normal_N_mean_steady {which}", f"rolling_to_normal_ratio_1 {which}"
+            row[f"F_n S100/S25 p1.9 {which}"] = (_value(t, _case("lin_red_s100_p1p9", k), fn)
+                                                  / _value(t, _case("lin_red_s25_p1p9", k), fn))
+            row[f"F_r/F_n p7.6/p1.9 S100 {which}"] = (_value(t, _case("lin_red_s100_p7p6", k), frfn)
+                                                       / _value(t, _case("lin_red_s100_p1p9", k), frfn))
         rows.append(row)
     return pd.DataFrame(rows).set_index("packing_seed")
 
@@ -128,10 +151,7 @@ def trends_same_cases(kind: str = "linear") -> pd.DataFrame:
     from deckgen.families import trend_table
 
     family = {"linear": "linear_ccs", "indentation": "indentation_asymmetric"}[kind]
-    old_dir, new_dir, key, _ = KINDS[kind]
-    new = pd.read_csv(new_dir / "family_table.csv")
-    old = pd.read_csv(old_dir / "family_table.csv")
-    old = old[old[key].isin(new[key])]
+    old, new = _same_case_tables(kind)
     cols = ["runs", "groups", "change_1", "change_1_ci95_low", "change_1_ci95_high", "p_value", "seed_change_1"]
     out = []
     for which, table in (("recorded", old), ("held", new)):
@@ -147,11 +167,7 @@ def regression_same_cases(min_p_full_mm: float = 0.0) -> pd.DataFrame:
     scale)."""
     from deckgen.families import family_regression
 
-    old_dir, new_dir, key, _ = KINDS["linear"]
-    new = pd.read_csv(new_dir / "family_table.csv")
-    new = new[new["penetration_full_mm"] > min_p_full_mm]
-    old = pd.read_csv(old_dir / "family_table.csv")
-    old = old[old[key].isin(new[key])]
+    old, new = _same_case_tables("linear", min_p_full_mm)
     cols = ["estimate", "std_error", "p_value", "r_squared", "n_runs"]
     out = []
     for which, table in (("recorded", old), ("held", new)):
@@ -167,12 +183,10 @@ def fn_p_ratio() -> pd.DataFrame:
     m = "force_normal_N_mean_steady"
     rows = []
     for k in sorted(set(unrel["packing_seed"])):
-        suffix = "" if k == 12345 else f"_k{k}"
         row = {"packing_seed": k}
         for label, t, tail in (("grooved", grooved, ""), ("unrelieved", unrel, "_unrel")):
             for which in ("recorded", "held"):
-                lo, hi = (t.loc[f"lin_red_s100_p{p}{suffix}{tail}", f"{m} {which}"] if f"lin_red_s100_p{p}{suffix}{tail}" in t.index
-                          else float("nan") for p in ("1p9", "7p6"))
+                lo, hi = (_value(t, _case(f"lin_red_s100_p{p}", k, tail), f"{m} {which}") for p in ("1p9", "7p6"))
                 row[f"{label} {which} p1.9 N"], row[f"{label} {which} p7.6 N"] = lo, hi
                 row[f"{label} {which} p7.6/p1.9"] = hi / lo
         rows.append(row)
@@ -182,7 +196,7 @@ def fn_p_ratio() -> pd.DataFrame:
 def main() -> None:
     with pd.option_context("display.width", 250, "display.max_columns", 40):
         for kind in KINDS:
-            if not (KINDS[kind][1] / "family_table.csv").is_file():
+            if not _has(kind):
                 print(f"{kind}: no held-shell report yet")
                 continue
             print(f"== {kind}")
@@ -191,24 +205,24 @@ def main() -> None:
             if len(s):
                 print(s.round(3).to_string(index=False))
             print()
-        if all((KINDS[k][1] / "family_table.csv").is_file() for k in ("linear", "linear shell0p5")):
+        if _has("linear") and _has("linear shell0p5"):
             print("== the finer shell on the fixed deck")
             print(shell_gain().round(3).T.to_string())
             print()
             print("== the linear trends as ratios (held and recorded runs of the same cases)")
             print(linear_ratios().round(3).T.to_string())
-        if all((KINDS[k][1] / "family_table.csv").is_file() for k in ("linear", "linear unrelieved")):
+        if _has("linear") and _has("linear unrelieved"):
             print()
             print("== F_n p 7.6 / p 1.9 mm at S 100 mm, with and without the neighbour grooves")
             print(fn_p_ratio().round(3).T.to_string())
-        if (KINDS["linear"][1] / "family_table.csv").is_file():
+        if _has("linear"):
             print()
             print("== seed 001's eq. 7 form on the held linear runs and the recorded runs of the same cases")
             print(regression_same_cases().round(4).to_string())
             print("-- without the p 1.9 mm cells")
             print(regression_same_cases(2.0).round(4).to_string())
         for kind in ("linear", "indentation"):
-            if (KINDS[kind][1] / "family_table.csv").is_file():
+            if _has(kind):
                 print()
                 print(f"== the {kind} family's trends, recorded and held runs of the same cases")
                 print(trends_same_cases(kind).round(3).T.to_string())

@@ -84,9 +84,10 @@ def test_reference_folders_are_small_and_complete(run):
             "broken.dump.gz", "bonds.dump.gz"} <= names
     size = sum(p.stat().st_size for p in run.iterdir())
     # 450 KB of dumps and logs, plus specimen.data (about 125 KB for ref_cut since session 34's regeneration: the chips
-    # read the initial bonds from it)
+    # read the initial bonds from it) and, since session 36, ref_cut's 7 atoms frames (138 KB: the cutter-contact census
+    # of tests/test_contacts.py reads them)
     data = (run / "specimen.data").stat().st_size if (run / "specimen.data").is_file() else 0
-    assert size - data < 450_000 and data < 150_000, f"{run}: {size} bytes; raise the dump intervals in make_runs.py"
+    assert size - data < 530_000 and data < 150_000, f"{run}: {size} bytes; raise the dump intervals in make_runs.py"
 
 
 # ----------------------------------------------------------------------------- bond counts
@@ -695,6 +696,6 @@ def test_the_cutter_shell_moves_rigidly_in_the_reference_cut():
     assert d[:, 0] == pytest.approx(moved, abs=5e-8) and np.abs(d[:, 2]).max() < 1e-12  # 6 digits in the dump
     path = Path(__file__).parents[1] / "docs" / "families_runs" / "shell_held" / "leak_timeline.py"
     t = load_script(path).timeline(CUT)
-    assert list(t["step"]) == [0, 42000] and list(t["grains_inside"]) == [0, 0]
+    assert list(t["step"]) == list(range(0, 42001, 7000)) and (t["grains_inside"] == 0).all()
     assert (t["shell_inside_fraction_1"] == 1.0).all()
     assert t["travel_fraction_1"].iloc[-1] == pytest.approx(1.0)

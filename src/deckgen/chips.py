@@ -57,6 +57,26 @@ def last_frame(run_dir: Path) -> pd.DataFrame:
     raise FileNotFoundError(f"{run_dir}: no final.dump.gz or atoms.dump.gz")
 
 
+def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """Connected components of the bond graph among the grains ``ids`` once the ``broken`` pairs are gone (both
+    atom-id pairs, any order): the component label of each grain (in the order of ``ids``), the component sizes and
+    the label of the largest one (the rock body; -1 without grains)."""
+    ids = np.asarray(ids, dtype=np.int64)
+    b = np.sort(np.asarray(bonds, dtype=np.int64).reshape(-1, 2), axis=1)
+    if len(broken) and len(b):
+        br = np.sort(np.asarray(broken, dtype=np.int64).reshape(-1, 2), axis=1)
+        m = max(int(b.max()), int(br.max())) + 1  # one integer per pair, so numpy does the set difference
+        b = b[~np.isin(b[:, 0] * m + b[:, 1], br[:, 0] * m + br[:, 1])]
+    b = b[np.isin(b[:, 0], ids) & np.isin(b[:, 1], ids)] if len(b) else b
+    n = len(ids)
+    index = pd.Series(np.arange(n), index=ids)
+    i, j = index.loc[b[:, 0]].to_numpy(), index.loc[b[:, 1]].to_numpy()
+    graph = coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
+    ncomp, label = connected_components(graph, directed=False)
+    sizes = np.bincount(label, minlength=ncomp)
+    return label, sizes, int(np.argmax(sizes)) if n else -1
+
+
 def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid_fraction: float,
                min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Chips of the remaining bond graph among rock grains (type 1) of ``atoms``.
@@ -66,20 +86,8 @@ def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid
     """
     rock = atoms[atoms["type"] == 1]
     ids = rock["id"].to_numpy(dtype=np.int64)
-    index = pd.Series(np.arange(len(ids)), index=ids)
-    b = np.sort(bonds, axis=1)
-    if len(broken):
-        br = np.sort(np.asarray(broken, dtype=np.int64), axis=1)
-        gone = set(map(tuple, br.tolist()))
-        keep = np.array([tuple(p) not in gone for p in b.tolist()], dtype=bool) if len(b) else np.zeros(0, bool)
-        b = b[keep]
-    b = b[np.isin(b[:, 0], ids) & np.isin(b[:, 1], ids)] if len(b) else b
+    label, sizes, body = bond_components(bonds, broken, ids)
     n = len(ids)
-    i, j = index.loc[b[:, 0]].to_numpy(), index.loc[b[:, 1]].to_numpy()
-    graph = coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
-    ncomp, label = connected_components(graph, directed=False)
-    sizes = np.bincount(label, minlength=ncomp)
-    body = int(np.argmax(sizes)) if n else -1
     r = rock["radius"].to_numpy(dtype=float)
     x = rock[["x", "y", "z"]].to_numpy(dtype=float)
     vol = 4.0 / 3.0 * math.pi * r**3

@@ -144,6 +144,20 @@ def cmd_parse(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_contacts(args: argparse.Namespace) -> int:
+    from deckgen.contacts import census_of_parsed
+
+    t = census_of_parsed(Path(args.dir), Path(args.parsed))
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    t.to_csv(out, index=False)
+    touch = t[t["force_z_hertz_N"] > 0]
+    share = touch["detached_share_z_1"].mean() if len(touch) else float("nan")
+    print(f"{args.dir}: {len(t)} dumped steps, {len(touch)} with contact; chips and debris carry {share:.3g} of the "
+          f"rebuilt normal load on average (wrote {out})")
+    return 0
+
+
 def cmd_aggregate(args: argparse.Namespace) -> int:
     from deckgen.results import aggregate
 
@@ -246,6 +260,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="cutting runs: read the means over these fractions of the travel instead of the case's "
                         "outputs.steady_window (the summary records the window and its source)")
     s.set_defaults(func=cmd_parse)
+    s = sub.add_parser("contacts", help="what carries the cutter's load at each dumped step: body, chips or debris")
+    s.add_argument("dir", help="run folder (shell cutter)")
+    s.add_argument("--parsed", required=True, help="its `deckgen parse` folder")
+    s.add_argument("--out", required=True, help="CSV to write")
+    s.set_defaults(func=cmd_contacts)
     s = sub.add_parser("aggregate", help="one table per kind across parsed runs")
     s.add_argument("dirs", nargs="+")
     s.add_argument("--out", required=True)

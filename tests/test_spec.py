@@ -72,6 +72,9 @@ def test_case_files_hold_overrides_only(tmp_path):
         ("kinematics:\n  mode: oscillation\nspecimen:\n  kind: cutting_block\n", "kinematics",
          "needs eccentricity_mm > 0"),
         ("packing:\n  radius_min_mm: 2\n  radius_max_mm: 1\n", "packing", "radius_max_mm must be >= radius_min_mm"),
+        ("run:\n  debris_removal_every: 1000\n", "run.debris_removal_every", "a LAMMPS cutting diagnostic"),
+        ("run:\n  debris_removal_every: -5\n", "run.debris_removal_every", "greater than or equal to 0"),
+        ("bonds:\n  model: flat_joint\nengine: liggghts\n", "bonds.model", "flat_joint is a LAMMPS plugin"),
     ],
 )
 def test_bad_input_gives_one_clear_line(tmp_path, text, field, words):
@@ -82,7 +85,7 @@ def test_bad_input_gives_one_clear_line(tmp_path, text, field, words):
     first = msg.splitlines()[0]
     assert first.startswith(f"{p}: {field}:"), msg
     assert words in first
-    assert "(fix: " in first
+    assert first.count("(fix: ") == 1
 
 
 def test_missing_file_and_bad_yaml(tmp_path):

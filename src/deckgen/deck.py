@@ -680,6 +680,9 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         lo[2] = min(lo[2], -pad)
         hi[2] = max(hi[2], path["zc0"] + R + 2 * path["ecc"] + pad)
         box = np.stack([lo, hi], axis=1)
+        debris_every = run.debris_removal_every
+        if debris_every:  # the cut runs in chunks of debris_every steps, so its outputs must divide the chunk
+            quantum = math.lcm(quantum, debris_every)
         steps = _round_up(int(math.ceil(path["duration"] / dt)), quantum)
         if steps > run.max_steps:
             raise SpecError(f"run.max_steps: the cut needs {steps} steps at dt {dt:.3g} s "
@@ -702,7 +705,12 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
                _var("ax_y", path["axis_y"], "rotary axis y", "m")] if case.kinematics.mode == "rotary" else []),
             _var("nsteps", steps, "steps of the cut", "steps"),
             _var("dump_every", case.outputs.dump_every or max(1, steps // 10), "per-atom dump interval", "steps"),
+            *([_var("debris_every", debris_every, "delete grains without bonds every this many steps", "steps"),
+               _var("debris_chunks", steps // debris_every, "chunks of the cut", "1")] if debris_every else []),
         ]
+        ctx["debris_removal"] = bool(debris_every)
+        if debris_every:
+            derived["debris_removal_every"] = debris_every
         ctx["smooth"], ctx["smooth_rotate"] = smooth, None
         if smooth:
             cone_vars, ctx["smooth_rotate"] = smooth_cone_variables(case, files["mesh"], path, float(r_full.max()))

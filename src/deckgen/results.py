@@ -565,7 +565,9 @@ def _broken_timeseries(broken: pd.DataFrame, ts: pd.DataFrame) -> pd.DataFrame:
 
 
 # ----------------------------------------------------------------------------- damage
-def _damage(run_dir: Path, state: _RunState) -> tuple[pd.DataFrame, dict[str, Any]]:
+def _damage(run_dir: Path, state: _RunState, debris_deleted: bool = False) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Per-grain damage from the first and the last frame. ``debris_deleted``: the deck deleted grains that had lost
+    all their bonds (``run.debris_removal_every``), so a grain missing from the last frame has 0 bonds there."""
     cols = ["id", "type", "radius", "x", "y", "z", "c_nb"]
     atoms = run_dir / "atoms.dump.gz"
     final = run_dir / "final.dump.gz"
@@ -601,6 +603,10 @@ def _damage(run_dir: Path, state: _RunState) -> tuple[pd.DataFrame, dict[str, An
     ids = d0["id"].to_numpy().astype(np.int64)
     nb1 = fin.reindex(ids)
     missing = int(nb1.isna().sum())
+    deleted = 0
+    if debris_deleted and missing:
+        deleted, missing = missing, 0
+        nb1 = nb1.fillna(0)
     dmg = pd.DataFrame({
         "id": ids, "radius_m": d0["radius"].to_numpy(dtype=float), "x_m": d0["x"].to_numpy(dtype=float),
         "y_m": d0["y"].to_numpy(dtype=float), "z_m": d0["z"].to_numpy(dtype=float),
@@ -615,6 +621,9 @@ def _damage(run_dir: Path, state: _RunState) -> tuple[pd.DataFrame, dict[str, An
     dmg = dmg.sort_values("id", kind="stable").reset_index(drop=True)
     if missing:
         state.notes.append(f"{missing} grain(s) missing from the final frame (lost atoms): damage NaN")
+    if deleted:
+        state.notes.append(f"{deleted} grain(s) deleted as loose debris (run.debris_removal_every): damage 1, not in "
+                           "the chips' removed volume")
     info["final_xyz_m"] = d1[["x", "y", "z"]].to_numpy(dtype=float)
     info.update({
         "damage_source": source, "damage_step": int(last.timestep), "n_grains_missing_final": missing,
@@ -996,7 +1005,7 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
     broken = broken[BROKEN_COLUMNS]
     bts = _broken_timeseries(broken, ts)
 
-    dmg, dinfo = _damage(run_dir, state)
+    dmg, dinfo = _damage(run_dir, state, debris_deleted=bool(derived.get("debris_removal_every")))
 
     bonds_broken_series = int(ts["bonds_broken"].iloc[-1]) if len(ts) else _nan()
     bonds_broken = len(broken) if have_broken else bonds_broken_series

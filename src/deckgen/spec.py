@@ -446,6 +446,13 @@ class RunControl(_Model):
     mass_scaling: float = _f(1.0, "1", "Density scale factor (quasi-static platen tests only).", ge=1, le=1e4)
     max_steps: int = _f(2_000_000, "steps", "Safety cap on time steps of the main run.", ge=1)
     thermo_every: int = _f(1000, "steps", "Thermo output interval.", ge=1)
+    debris_removal_every: int = _f(
+        0, "steps",
+        "Cutting diagnostic (0 = off): every N steps, delete the rock grains that have lost all their bonds, as if "
+        "the crushed grains left the cut at once. Not a lab condition: it tests whether loose grains under the disc "
+        "set the force (deckgen contacts). LAMMPS shell or smooth cutters; the cut's steps become a multiple of N.",
+        ge=0,
+    )
 
 
 class Outputs(_Model):
@@ -498,6 +505,13 @@ class Case(_Model):
         sp = self.specimen
         if self.bonds.model == "flat_joint" and self.engine != "lammps":
             raise ValueError("bonds.model: flat_joint is a LAMMPS plugin (fix: engine lammps, or model bpm_rotational)")
+        if self.run.debris_removal_every:
+            if self.test != "cutting" or self.engine != "lammps":
+                raise ValueError("run.debris_removal_every: a LAMMPS cutting diagnostic (fix: 0, or test cutting with "
+                                 "engine lammps)")
+            if self.bonds.model != "bpm_rotational":
+                raise ValueError("run.debris_removal_every: loose grains are found by their BPM bonds (fix: 0, or "
+                                 "bonds.model bpm_rotational)")
         dmin = {"ucs_cylinder": lambda s: min(s.diameter_mm, s.height_mm),
                 "brazilian_disc": lambda s: min(s.diameter_mm, s.thickness_mm),
                 "cutting_block": lambda s: min(s.length_mm, s.width_mm, s.height_mm)}[sp.kind](sp)
@@ -594,7 +608,8 @@ def format_validation_error(path: str | Path, exc: ValidationError) -> str:
     lines = []
     for err in exc.errors():
         field, msg, _ = field_and_message(err)
-        lines.append(f"{path}: {field}: {msg} (fix: {_fix_hint(err)})")
+        # a cross-field check that names its own fix keeps it alone
+        lines.append(f"{path}: {field}: {msg}" + ("" if "(fix: " in msg else f" (fix: {_fix_hint(err)})"))
     return "\n".join(lines)
 
 

@@ -385,4 +385,5 @@ def test_debris_removal_deletes_loose_grains_and_keeps_the_bond_count(tmp_path, 
     assert final["c_nb"].sum() / 2 == s["bonds"].iloc[-1] < spec["derived"]["n_bonds"]
     summary = parse_run(out, tmp_path / "parsed")
     assert summary["run_completed"] and summary["n_grains_missing_final"] == 0
+    assert summary["n_grains_deleted_debris"] == total
     assert f"{total} grain(s) deleted as loose debris" in summary["notes"]

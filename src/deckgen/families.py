@@ -825,7 +825,7 @@ TABLE_FIELDS = [
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
     "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
-    "specific_energy_kinematic_J_m3", "grains_inside_cutter_final",
+    "specific_energy_kinematic_J_m3", "grains_inside_cutter_final", "n_grains_deleted_debris",
 ]
 
 
@@ -840,6 +840,7 @@ VARIANT_FIELDS = (
     ("neighbour_spacing_mm", "kinematics", "neighbour_spacing_mm"), ("block_height_mm", "specimen", "height_mm"),
     ("block_width_mm", "specimen", "width_mm"), ("kinematics_mode", "kinematics", "mode"),
     ("rotary_radius_mm", "kinematics", "rotary_radius_mm"),
+    ("debris_removal_every", "run", "debris_removal_every"),
 )
 
 
@@ -892,7 +893,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     import pandas as pd
 
-    from deckgen.spec import Contact, Cutter, CuttingBlock, Kinematics
+    from deckgen.spec import Contact, Cutter, CuttingBlock, Kinematics, RunControl
 
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
@@ -923,7 +924,8 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             s = {**s, "case": target}
         elif variants:
             row["variant_case"] = s["case"]
-            models = {"cutter": Cutter, "contact": Contact, "kinematics": Kinematics, "specimen": CuttingBlock}
+            models = {"cutter": Cutter, "contact": Contact, "kinematics": Kinematics, "specimen": CuttingBlock,
+                      "run": RunControl}
             row.update({col: spec.get("case", {}).get(sec, {}).get(f, models[sec].model_fields[f].default)
                         for col, sec, f in VARIANT_FIELDS})
             if row["kinematics_mode"] != "rotary":  # the schema's default radius means nothing off the rotary path

@@ -29,7 +29,8 @@
     ``bonds_initial`` (first frame of ``atoms.dump.gz``), ``bonds_final`` (``final.dump.gz``, or
     the last frame of ``atoms.dump.gz`` when the run stopped before writing it),
     ``damage_ratio_1 = 1 - bonds_final / bonds_initial`` (broken / initial bonds as in seed 000;
-    NaN for grains without an initial bond or missing from the final frame).
+    NaN for grains without an initial bond or missing from the final frame; a grain deleted as loose debris by
+    ``run.debris_removal_every`` has ``bonds_final`` 0, is counted in ``n_grains_deleted_debris`` and not missing).
 ``summary.json``
     one flat dict of scalars (NaN written as ``null``), see :func:`parse_run`.
 
@@ -92,7 +93,8 @@ UNITLESS_COLUMNS = frozenset({
     "case", "engine", "test", "mode", "step", "id", "id1", "id2", "btype", "sample_step",
     "bonds_intact", "peak_reached", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
-    "n_grains_bonded", "n_grains_missing_final", "grains_inside_cutter_final", "steps", "final_step", "damage_step",
+    "n_grains_bonded", "n_grains_missing_final", "n_grains_deleted_debris", "grains_inside_cutter_final", "steps",
+    "final_step", "damage_step",
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
     "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
@@ -138,7 +140,7 @@ _COMMON_SUMMARY = [
     "case", "test", "engine", "n_grains", "n_bonds_initial", "bonds_broken", "broken_fraction_1",
     "bonds_broken_tension", "bonds_broken_shear", "bonds_broken_unknown", "mode_source",
     "bonds_broken_series", "bonds_broken_dumps", "damage_ratio_mean_1",
-    "damaged_grain_fraction_1", "n_grains_bonded", "n_grains_missing_final", "damage_source",
+    "damaged_grain_fraction_1", "n_grains_bonded", "n_grains_missing_final", "n_grains_deleted_debris", "damage_source",
     "damage_step", "dt_s", "final_step", "final_time_s", "run_completed", "steps", "wall_s",
     "loop_s", "particle_steps_per_s", "log_failure", "notes",
 ]
@@ -572,7 +574,7 @@ def _damage(run_dir: Path, state: _RunState, debris_deleted: bool = False) -> tu
     atoms = run_dir / "atoms.dump.gz"
     final = run_dir / "final.dump.gz"
     info: dict[str, Any] = {"damage_source": "none", "damage_step": _nan(), "bonds_broken_dumps": _nan(),
-                            "n_grains_missing_final": _nan()}
+                            "n_grains_missing_final": _nan(), "n_grains_deleted_debris": 0}
     empty = pd.DataFrame({c: pd.Series(dtype="float64") for c in DAMAGE_COLUMNS})
     if not atoms.is_file():
         state.notes.append("no atoms.dump.gz: no damage table")
@@ -627,6 +629,7 @@ def _damage(run_dir: Path, state: _RunState, debris_deleted: bool = False) -> tu
     info["final_xyz_m"] = d1[["x", "y", "z"]].to_numpy(dtype=float)
     info.update({
         "damage_source": source, "damage_step": int(last.timestep), "n_grains_missing_final": missing,
+        "n_grains_deleted_debris": deleted,
         # (sum c_nb initial - sum c_nb final) / 2 over rock grains present in both frames
         "bonds_broken_dumps": (int(nb0.sum()) - int(np.nansum(nb1.to_numpy(dtype=float)))) / 2.0
         if not missing else _nan(),
@@ -1027,6 +1030,7 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
         "damaged_grain_fraction_1": float((ratio[finite] > 0).mean()) if finite.any() else _nan(),
         "n_grains_bonded": int(bonded.sum()),
         "n_grains_missing_final": dinfo["n_grains_missing_final"],
+        "n_grains_deleted_debris": dinfo["n_grains_deleted_debris"],
         "damage_source": dinfo["damage_source"], "damage_step": dinfo["damage_step"],
         "dt_s": dt,
         "final_step": int(ts["step"].iloc[-1]) if len(ts) else _nan(),

@@ -11,6 +11,8 @@ block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair 
 (``linear_h24``, new).
 
     python docs/families_runs/shell_held/compare.py
+    python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
+    python docs/families_runs/shell_held/compare.py --contacts docs/families_runs/shell_held/linear_contacts.csv <X>...
 
 Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
 its 95 % interval (``../rotary_shell0p5/compare.py``'s ``gain_row``); then, where both shells ran on the fixed deck,
@@ -20,6 +22,8 @@ eq. 7 form and the family's trends on the held runs beside the recorded runs of 
 from __future__ import annotations
 
 import importlib.util
+import json
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -38,6 +42,15 @@ KINDS = {
                     ("force_normal_N_peak", "force_side_N_peak", "lateral_to_normal_ratio_1")),
 }
 EXTRA = ("grains_inside_cutter_final", "bonds_broken", "broken_fraction_1", "wall_s")
+#: steady windows of :func:`window_table`: the contact-patch centre between lo and lo + 0.2 of the block length (the
+#: family cases average over lo = 0.4, seed 001's middle of the block, which ends where the travel ends)
+PATCH_WINDOWS = (0.1, 0.2, 0.3, 0.4)
+#: the held linear runs' F_n and F_r over each of PATCH_WINDOWS (written by ``--windows``)
+WINDOWS_CSV = HERE / "linear_windows.csv"
+#: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
+CONTACTS_CSV = HERE / "linear_contacts.csv"
+#: report (``--variants``) of the S 100 mm family cases with run.debris_removal_every (session 36)
+DEBRIS_DIR = HERE / "linear_debris"
 
 
 def load_gain_row():
@@ -193,7 +206,177 @@ def fn_p_ratio() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("packing_seed")
 
 
+def window_table(parsed: list[Path]) -> pd.DataFrame:
+    """F_n and F_r of each held linear run averaged over every window of :data:`PATCH_WINDOWS` (``families.middle_window``
+    from the run's own block, disc, penetration and travel; ``results.steady_mask`` on its parsed series): one row per
+    run and window. ``parsed`` are ``deckgen parse`` folders with the run folder beside them as ``../run``."""
+    from deckgen.families import middle_window
+    from deckgen.results import steady_mask
+
+    rows = []
+    for d in map(Path, parsed):
+        spec_path = d.parent / "run" / "spec.json"
+        if not (d / "summary.json").is_file() or not spec_path.is_file():
+            raise SystemExit(f"{d}: needs summary.json and ../run/spec.json (fix: pass the parsed folder of a run "
+                             "made by `deckgen render CASE --out X/run` and `deckgen parse X/run --out X/parsed`)")
+        s = json.loads((d / "summary.json").read_text())
+        case = json.loads(spec_path.read_text())["case"]
+        k = case["kinematics"]
+        ts = pd.read_parquet(d / "timeseries.parquet", columns=["time_s", "force_normal_N", "force_rolling_N"])
+        for lo in PATCH_WINDOWS:
+            w = middle_window(case["specimen"]["length_mm"], 1e3 * s["cutter_radius_m"], k["penetration_mm"],
+                              k["start_clearance_mm"], k["travel_mm"], lo, lo + 0.2)
+            m = steady_mask(ts["time_s"], s["cut_duration_s"], w)
+            rows.append({"case": s["case"], "patch_lo_1": lo, "window_start_1": w[0], "window_end_1": w[1],
+                         "rows": int(m.sum()), "force_normal_N_mean_steady": ts.loc[m, "force_normal_N"].mean(),
+                         "force_rolling_N_mean_steady": ts.loc[m, "force_rolling_N"].mean()})
+    return pd.DataFrame(rows)
+
+
+def window_fits(windows: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Per window of :data:`PATCH_WINDOWS`: seed 001's eq. 7 on the held linear runs' windowed F_n and F_r (S and p
+    terms: estimate, p, R^2) and F_n at p 7.6 / 1.9 mm (S 100 mm) as the geometric mean over the packings that ran
+    both. Whether the fall of F_n with p belongs to the case's window (the disc's last ~5 mm, near the fixed far end)
+    or to the whole cut."""
+    import numpy as np
+
+    from deckgen.families import family_regression
+
+    w = pd.read_csv(WINDOWS_CSV) if windows is None else windows
+    base = pd.read_csv(KINDS["linear"][1] / "family_table.csv")
+    rows = []
+    for lo, g in w.groupby("patch_lo_1"):
+        t = base.drop(columns=["force_normal_N_mean_steady", "force_rolling_N_mean_steady"]).merge(
+            g[["case", "force_normal_N_mean_steady", "force_rolling_N_mean_steady"]], on="case")
+        fit = family_regression("linear_ccs", t).set_index(["response", "term"])
+        row = {"patch_lo_1": lo, "runs": len(t)}
+        for resp, short in (("force_normal_N_mean_steady", "F_n"), ("force_rolling_N_mean_steady", "F_r")):
+            for term, name in (("spacing_mm", "S"), ("penetration_mm", "p")):
+                row[f"{short} {name} N/mm"] = fit.loc[(resp, term), "estimate"]
+                row[f"{short} {name} p"] = fit.loc[(resp, term), "p_value"]
+            row[f"{short} R2"] = fit.loc[(resp, term), "r_squared"]
+        fn = t.set_index("case")["force_normal_N_mean_steady"]
+        ratios = [fn[_case("lin_red_s100_p7p6", k)] / fn[_case("lin_red_s100_p1p9", k)]
+                  for k in sorted(set(t["packing_seed"]))
+                  if _case("lin_red_s100_p7p6", k) in fn and _case("lin_red_s100_p1p9", k) in fn]
+        row["F_n p7.6/p1.9 S100"] = float(np.exp(np.mean(np.log(ratios)))) if ratios else float("nan")
+        row["packings"] = len(ratios)
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("patch_lo_1")
+
+
+def contact_table(runs: list[Path]) -> pd.DataFrame:
+    """``deckgen.contacts.census_of_parsed`` of each run folder pair ``X/run``, ``X/parsed`` given as ``X``: one row per
+    run and dumped step, with the case and the fraction of the cut's duration."""
+    from deckgen.contacts import census_of_parsed
+
+    parts = []
+    for d in map(Path, runs):
+        s = json.loads((d / "parsed" / "summary.json").read_text())
+        t = census_of_parsed(d / "run", d / "parsed")
+        t.insert(0, "case", s["case"])
+        t.insert(2, "cut_fraction_1", t["time_s"] / s["cut_duration_s"])
+        parts.append(t)
+    return pd.concat(parts, ignore_index=True)
+
+
+def contact_means(contacts: pd.DataFrame | None = None, from_fraction: float = 0.5) -> pd.DataFrame:
+    """Per run of the census (index: its case name): means over its dumped steps from ``from_fraction`` of the cut on
+    where the disc touches the rock (series F_z > 0): grains touching the disc (all, body, debris), the share of the
+    rebuilt normal load that chips and debris carry, the series F_z at those steps and the rebuilt / series ratio."""
+    c = pd.read_csv(CONTACTS_CSV) if contacts is None else contacts
+    c = c[(c["cut_fraction_1"] >= from_fraction) & (c["force_z_series_N"] > 0)]
+    g = c.groupby("case")
+    return pd.DataFrame({
+        "frames": g.size(), "grains_touching": g["grains_touching"].mean(),
+        "grains_touching_body": g["grains_touching_body"].mean(),
+        "grains_touching_debris": g["grains_touching_debris"].mean(),
+        "detached_share_z_1": g["detached_share_z_1"].mean(),
+        "force_z_series_N": g["force_z_series_N"].mean(),
+        "hertz_to_series_1": g["force_z_hertz_N"].sum() / g["force_z_series_N"].sum()})
+
+
+def contact_runs(contacts: pd.DataFrame | None = None, from_fraction: float = 0.5) -> pd.DataFrame:
+    """:func:`contact_means` of the held linear family runs, with S, p and the packing of the held family table."""
+    out = contact_means(contacts, from_fraction)
+    fam = pd.read_csv(KINDS["linear"][1] / "family_table.csv").set_index("case")
+    fam = fam[["spacing_mm", "penetration_mm", "penetration_full_mm", "packing_seed", "force_normal_N_mean_steady"]]
+    return fam.join(out, how="inner").reset_index()
+
+
+def contact_fits(contacts: pd.DataFrame | None = None) -> pd.DataFrame:
+    """On the held linear family runs (:func:`contact_runs`): OLS of the grains touching the disc and of the debris
+    share on S and p, and seed 001's eq. 7 form on the F_z of the same steps with and without the number of grains
+    touching as a third term (statsmodels): whether the fall of F_n with p goes with fewer grains under the disc."""
+    import statsmodels.formula.api as smf
+
+    t = contact_runs(contacts).rename(columns={"spacing_mm": "S", "penetration_mm": "p"})
+    rows = []
+    for label, formula in (("grains touching ~ S + p", "grains_touching ~ S + p"),
+                           ("debris touching ~ S + p", "grains_touching_debris ~ S + p"),
+                           ("detached share ~ S + p", "detached_share_z_1 ~ S + p"),
+                           ("F_z ~ S + p", "force_z_series_N ~ S + p"),
+                           ("F_z ~ S + p + touching", "force_z_series_N ~ S + p + grains_touching")):
+        fit = smf.ols(formula, data=t).fit()
+        for term in fit.params.index:
+            rows.append({"model": label, "term": term, "estimate": fit.params[term], "std_error": fit.bse[term],
+                         "p_value": fit.pvalues[term], "r_squared": fit.rsquared, "n_runs": int(fit.nobs)})
+    return pd.DataFrame(rows)
+
+
+def debris_effect() -> pd.DataFrame:
+    """S 100 mm, p 1.9 and 7.6 mm, packings 12345 and 202: each held family run beside the same case with
+    run.debris_removal_every 2000 (report ``linear_debris``; same grains and bonds, checked by the report): F_n, F_r,
+    F_r/F_n, bonds broken, grains deleted and, from the contact census where it holds the runs, the share of the disc's
+    normal load that chips and debris carry and the grains touching the disc; debris run / family run."""
+    fam = pd.read_csv(KINDS["linear"][1] / "family_table.csv").set_index("case")
+    deb = pd.read_csv(DEBRIS_DIR / "family_table.csv").set_index("case")
+    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
+    rows = []
+    for case, d in deb.iterrows():
+        f = fam.loc[case]
+        row = {"case": case, "packing_seed": int(d["packing_seed"]), "penetration_full_mm": d["penetration_full_mm"]}
+        for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
+                         ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken")):
+            row[f"{short} family"], row[f"{short} debris"] = f[m], d[m]
+            row[f"{short} debris/family"] = d[m] / f[m]
+        row["grains deleted"] = d["n_grains_deleted_debris"]
+        row["inside debris"] = d["grains_inside_cutter_final"]
+        for col, short in (("detached_share_z_1", "detached share"), ("grains_touching", "touching")):
+            for which, name in (("family", case), ("debris", d["variant_case"])):
+                row[f"{short} {which}"] = means.loc[name, col] if name in means.index else float("nan")
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("case")
+
+
+def debris_p_ratio() -> pd.DataFrame:
+    """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), family runs and debris-removal runs."""
+    t = debris_effect()
+    rows = []
+    for k, g in t.groupby("packing_seed"):
+        g = g.set_index("penetration_full_mm")
+        row = {"packing_seed": k}
+        for which in ("family", "debris"):
+            row[f"F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_n N {which}"] / g.loc[1.9, f"F_n N {which}"]
+            row[f"F_r/F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_r/F_n {which}"] / g.loc[1.9, f"F_r/F_n {which}"]
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing_seed")
+
+
 def main() -> None:
+    if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
+        t = contact_table([Path(a) for a in sys.argv[3:]])
+        t.to_csv(sys.argv[2], index=False, float_format="%.6g")
+        with pd.option_context("display.width", 250, "display.max_columns", 40):
+            print(contact_runs(t).round(3).to_string(index=False))
+            print(contact_fits(t).round(4).to_string(index=False))
+        return
+    if len(sys.argv) > 3 and sys.argv[1] == "--windows":
+        t = window_table([Path(a) for a in sys.argv[3:]])
+        t.to_csv(sys.argv[2], index=False, float_format="%.6g")
+        with pd.option_context("display.width", 250, "display.max_columns", 40):
+            print(window_fits(t).round(4).T.to_string())
+        return
     with pd.option_context("display.width", 250, "display.max_columns", 40):
         for kind in KINDS:
             if not _has(kind):
@@ -221,6 +404,20 @@ def main() -> None:
             print(regression_same_cases().round(4).to_string())
             print("-- without the p 1.9 mm cells")
             print(regression_same_cases(2.0).round(4).to_string())
+        if CONTACTS_CSV.is_file():
+            print()
+            print("== what carries the disc's load on the held linear runs (deckgen.contacts, second half of the cut)")
+            print(contact_runs().round(3).to_string(index=False))
+            print(contact_fits().round(4).to_string(index=False))
+        if (DEBRIS_DIR / "family_table.csv").is_file():
+            print()
+            print("== S 100 mm with the loose grains deleted every 2000 steps (run.debris_removal_every)")
+            print(debris_effect().round(3).T.to_string())
+            print(debris_p_ratio().round(3).T.to_string())
+        if WINDOWS_CSV.is_file():
+            print()
+            print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
+            print(window_fits().round(4).T.to_string())
         for kind in ("linear", "indentation"):
             if _has(kind):
                 print()

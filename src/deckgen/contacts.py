@@ -103,7 +103,7 @@ def cutter_load_census(run_dir: str | Path, broken: pd.DataFrame, series: pd.Dat
     k_hertz = hertz_stiffness(spec["case"])
     br_steps = broken["step"].to_numpy(np.int64)
     br_pairs = broken[["id1", "id2"]].to_numpy(np.int64)
-    ts = series.set_index("step")
+    ts = series.drop_duplicates("step", keep="last").set_index("step").sort_index()  # a restart repeats steps
     rows, last = [], -1
     for name in ("atoms.dump.gz", "final.dump.gz"):
         path = run_dir / name

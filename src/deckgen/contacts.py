@@ -29,9 +29,8 @@ from scipy.spatial import cKDTree
 from deckgen.chips import bond_components, initial_bonds
 from deckgen.deck import effective_modulus
 from deckgen.parse.dump import iter_frames
-from deckgen.spec import SpecError
+from deckgen.spec import GPA, SpecError
 
-GPA = 1e9
 CLASSES = ("body", "chip", "debris")
 CENSUS_COLUMNS = ["step", "time_s", "grains_touching", *(f"grains_touching_{c}" for c in CLASSES),
                   "force_x_hertz_N", "force_y_hertz_N", "force_z_hertz_N",

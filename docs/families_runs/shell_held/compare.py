@@ -77,6 +77,11 @@ def _value(t: pd.DataFrame, name: str, col: str) -> float:
     return t.loc[name, col] if name in t.index else float("nan")
 
 
+def _held_linear() -> pd.DataFrame:
+    """The report table of the held linear family runs (``linear``)."""
+    return pd.read_csv(KINDS["linear"][1] / "family_table.csv")
+
+
 def _same_case_tables(kind: str, min_p_full_mm: float = 0.0) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(recorded, held) report tables of ``kind``, the recorded one cut to the held cases; only cases with a full-scale
     p above ``min_p_full_mm`` (the indentation family has no p: leave 0)."""
@@ -243,7 +248,7 @@ def window_fits(windows: pd.DataFrame | None = None) -> pd.DataFrame:
     from deckgen.families import family_regression
 
     w = pd.read_csv(WINDOWS_CSV) if windows is None else windows
-    base = pd.read_csv(KINDS["linear"][1] / "family_table.csv")
+    base = _held_linear()
     rows = []
     for lo, g in w.groupby("patch_lo_1"):
         t = base.drop(columns=["force_normal_N_mean_steady", "force_rolling_N_mean_steady"]).merge(
@@ -299,7 +304,7 @@ def contact_means(contacts: pd.DataFrame | None = None, from_fraction: float = 0
 def contact_runs(contacts: pd.DataFrame | None = None, from_fraction: float = 0.5) -> pd.DataFrame:
     """:func:`contact_means` of the held linear family runs, with S, p and the packing of the held family table."""
     out = contact_means(contacts, from_fraction)
-    fam = pd.read_csv(KINDS["linear"][1] / "family_table.csv").set_index("case")
+    fam = _held_linear().set_index("case")
     fam = fam[["spacing_mm", "penetration_mm", "penetration_full_mm", "packing_seed", "force_normal_N_mean_steady"]]
     return fam.join(out, how="inner").reset_index()
 
@@ -329,7 +334,7 @@ def debris_effect() -> pd.DataFrame:
     run.debris_removal_every 2000 (report ``linear_debris``; same grains and bonds, checked by the report): F_n, F_r,
     F_r/F_n, bonds broken, grains deleted and, from the contact census where it holds the runs, the share of the disc's
     normal load that chips and debris carry and the grains touching the disc; debris run / family run."""
-    fam = pd.read_csv(KINDS["linear"][1] / "family_table.csv").set_index("case")
+    fam = _held_linear().set_index("case")
     deb = pd.read_csv(DEBRIS_DIR / "family_table.csv").set_index("case")
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []

@@ -75,6 +75,8 @@ def test_case_files_hold_overrides_only(tmp_path):
         ("run:\n  debris_removal_every: 1000\n", "run.debris_removal_every", "a LAMMPS cutting diagnostic"),
         ("run:\n  debris_removal_every: -5\n", "run.debris_removal_every", "greater than or equal to 0"),
         ("bonds:\n  model: flat_joint\nengine: liggghts\n", "bonds.model", "flat_joint is a LAMMPS plugin"),
+        ("specimen:\n  kind: cutting_block\npacking:\n  radius_min_mm: 0.35\n  radius_max_mm: 0.5\n", "cutter.shell_radius_mm",
+         "more than half of any grain radius the packing can have (0.245 mm)"),
     ],
 )
 def test_bad_input_gives_one_clear_line(tmp_path, text, field, words):
@@ -86,6 +88,18 @@ def test_bad_input_gives_one_clear_line(tmp_path, text, field, words):
     assert first.startswith(f"{p}: {field}:"), msg
     assert words in first
     assert first.count("(fix: ") == 1
+
+
+def test_shell_radius_is_refused_before_packing_only_where_no_packing_can_pass(tmp_path):
+    """The deck holds cutter.shell_radius_mm to half the packing's smallest grain radius after packing; the case check
+    refuses only radii above half the largest grain a packing can have (r_max x (1 - shrink_before_bonding)), so it
+    never refuses a case the deck would take."""
+    grains = "specimen:\n  kind: cutting_block\npacking:\n  radius_min_mm: 0.35\n  radius_max_mm: 0.5\n"
+    assert load_case(write(tmp_path, grains + "cutter:\n  shell_radius_mm: 0.245\n")).cutter.shell_radius_mm == 0.245
+    with pytest.raises(SpecError, match=r"cutter\.shell_radius_mm: 0\.246 mm .*\(fix: at most half the smallest grain radius, 0\.171 mm\)"):
+        load_case(write(tmp_path, grains + "cutter:\n  shell_radius_mm: 0.246\n"))
+    # the LIGGGHTS decks cut with the STL mesh, not a shell of spheres
+    assert load_case(write(tmp_path, grains + "engine: liggghts\nbonds:\n  enabled: false\n")).engine == "liggghts"
 
 
 def test_missing_file_and_bad_yaml(tmp_path):

@@ -565,6 +565,15 @@ class Case(_Model):
                                      "(clearance_angle_deg or tilt_deg not 0) cannot also spin with friction (fix: "
                                      "contact.cutter_friction 0, where the spin of a smooth cone does not matter, "
                                      "kinematics.spin none, or surface shell)")
+            elif self.engine == "lammps":
+                # the LAMMPS deck holds the shell radius to half the packing's smallest grain radius once the packing
+                # exists (deck.render_case); above half the largest radius a grain can have after the bonding shrink,
+                # every packing fails that check, so say it here instead of after minutes of packing
+                r_top = p.radius_max_mm * (1.0 - self.bonds.shrink_before_bonding)
+                if cu.shell_radius_mm > 0.5 * r_top:
+                    raise ValueError(f"cutter.shell_radius_mm: {cu.shell_radius_mm:g} mm is more than half of any grain "
+                                     f"radius the packing can have ({0.5 * r_top:.3g} mm) (fix: at most half the "
+                                     f"smallest grain radius, {0.5 * p.radius_min_mm * (1.0 - self.bonds.shrink_before_bonding):.3g} mm)")
         return self
 
 

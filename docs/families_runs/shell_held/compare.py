@@ -8,10 +8,14 @@ cases (and session 32's finer-shell and session 31's unrelieved diagnostics) ren
 unchanged otherwise: the same grains and bonds as the recorded run (checked), so each pair differs only in the deck's y
 motion of the shell. Session 35 added 16 linear family cases (22 in ``linear``), the unrelieved pairs and the 45 mm
 block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair with) and a 24 mm high block
-(``linear_h24``, new).
+(``linear_h24``, new). Session 36 brought ``linear`` to 43 cases and added the contact census, the windows and the
+S 100 mm debris-removal runs (``linear_debris``); session 37 the last five cases (48) and the whole packing-12345
+family with run.debris_removal_every.
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
+    python docs/families_runs/shell_held/compare.py --debris-windows docs/families_runs/shell_held/linear_debris_windows.csv \
+        <parsed of the packing-12345 debris-removal runs>...
     python docs/families_runs/shell_held/compare.py --contacts docs/families_runs/shell_held/linear_contacts.csv <X>...
 
 Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
@@ -47,9 +51,13 @@ EXTRA = ("grains_inside_cutter_final", "bonds_broken", "broken_fraction_1", "wal
 PATCH_WINDOWS = (0.1, 0.2, 0.3, 0.4)
 #: the held linear runs' F_n and F_r over each of PATCH_WINDOWS (written by ``--windows``)
 WINDOWS_CSV = HERE / "linear_windows.csv"
+#: the debris-removal runs of the packing-12345 family over the same windows, keyed by their family case (``--windows``
+#: on their parsed folders writes them as ``*_debris``; ``--debris-windows`` strips the suffix)
+DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
 CONTACTS_CSV = HERE / "linear_contacts.csv"
-#: report (``--variants``) of the S 100 mm family cases with run.debris_removal_every (session 36)
+#: report (``--variants``) of the family cases run with run.debris_removal_every (S 100 mm on packings 12345 and 202 in
+#: session 36; the whole packing-12345 family in session 37)
 DEBRIS_DIR = HERE / "linear_debris"
 
 
@@ -330,16 +338,21 @@ def contact_fits(contacts: pd.DataFrame | None = None) -> pd.DataFrame:
 
 
 def debris_effect() -> pd.DataFrame:
-    """S 100 mm, p 1.9 and 7.6 mm, packings 12345 and 202: each held family run beside the same case with
-    run.debris_removal_every 2000 (report ``linear_debris``; same grains and bonds, checked by the report): F_n, F_r,
+    """Every case of report ``linear_debris`` (S 100 mm at p 1.9 and 7.6 mm on packings 12345 and 202, session 36; the
+    whole packing-12345 family, session 37): each held family run beside the same case with
+    run.debris_removal_every 2000: F_n, F_r,
     F_r/F_n, bonds broken, grains deleted and, from the contact census where it holds the runs, the share of the disc's
-    normal load that chips and debris carry and the grains touching the disc; debris run / family run."""
+    normal load that chips and debris carry and the grains touching the disc; debris run / family run. Raises unless
+    each debris run shares its grains and bonds with its family run."""
     fam = _held_linear().set_index("case")
     deb = pd.read_csv(DEBRIS_DIR / "family_table.csv").set_index("case")
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
     for case, d in deb.iterrows():
         f = fam.loc[case]
+        if (d["n_grains"], d["n_bonds_initial"]) != (f["n_grains"], f["n_bonds_initial"]):
+            raise ValueError(f"{DEBRIS_DIR}: {d['variant_case']} does not share its grains and bonds with the held run "
+                             f"of {case}")
         row = {"case": case, "packing_seed": int(d["packing_seed"]), "penetration_full_mm": d["penetration_full_mm"]}
         for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
                          ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken")):
@@ -357,6 +370,7 @@ def debris_effect() -> pd.DataFrame:
 def debris_p_ratio() -> pd.DataFrame:
     """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), family runs and debris-removal runs."""
     t = debris_effect()
+    t = t[[c.startswith("lin_red_s100_") for c in t.index]]
     rows = []
     for k, g in t.groupby("packing_seed"):
         g = g.set_index("penetration_full_mm")
@@ -368,6 +382,57 @@ def debris_p_ratio() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("packing_seed")
 
 
+def _debris_family_tables(packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(held family runs, debris-removal runs) of the linear family cases of ``packing`` that ran with
+    run.debris_removal_every (report ``linear_debris``), the family table cut to the same cases; the debris table keyed
+    by the family case, as the family's trend and regression code reads it."""
+    deb = pd.read_csv(DEBRIS_DIR / "family_table.csv")
+    deb = deb[deb["packing_seed"] == packing]
+    fam = _held_linear()
+    fam = fam[fam["case"].isin(deb["case"])]
+    if len(fam) != len(deb):
+        raise ValueError(f"{DEBRIS_DIR}: debris runs without a held family run: "
+                         f"{sorted(set(deb['case']) - set(fam['case']))}")
+    both = deb.merge(fam, on="case", suffixes=("", " family"))
+    if ((both["n_grains"] != both["n_grains family"]) | (both["n_bonds_initial"] != both["n_bonds_initial family"])).any():
+        raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
+    return fam, deb
+
+
+def debris_family_fits(packing: int = 12345) -> pd.DataFrame:
+    """Seed 001's eq. 7 form (``deckgen.families.family_regression``) on the debris-removal runs of ``packing`` and on
+    the held family runs of the same cases, side by side (estimate, p, R^2 per response and term): whether F_n still
+    falls with p and rises with S once the loose grains leave the cut."""
+    from deckgen.families import family_regression
+
+    cols = ["estimate", "std_error", "p_value", "r_squared", "n_runs"]
+    fam, deb = _debris_family_tables(packing)
+    out = [family_regression("linear_ccs", t).set_index(["response", "term"])[cols].add_prefix(f"{which} ")
+           for which, t in (("family", fam), ("debris", deb))]
+    return pd.concat(out, axis=1)
+
+
+def debris_family_trends(packing: int = 12345) -> pd.DataFrame:
+    """The family's trends (``deckgen.families.trend_table``) on the debris-removal runs of ``packing`` and on the held
+    family runs of the same cases, side by side."""
+    from deckgen.families import trend_table
+
+    cols = ["runs", "change_1", "change_1_ci95_low", "change_1_ci95_high", "p_value", "seed_change_1"]
+    fam, deb = _debris_family_tables(packing)
+    out = [trend_table("linear_ccs", t).set_index("trend")[cols].add_prefix(f"{which} ")
+           for which, t in (("family", fam), ("debris", deb))]
+    return pd.concat(out, axis=1)
+
+
+def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_steady") -> pd.DataFrame:
+    """``metric`` of the debris-removal runs of ``packing`` as a table: full-scale p down, S across, and beside it the
+    held family run's value (columns ``family S..``)."""
+    fam, deb = _debris_family_tables(packing)
+    grids = [t.pivot_table(index="penetration_full_mm", columns="spacing_full_mm", values=metric).add_prefix(
+        f"{which} S") for which, t in (("debris", deb), ("family", fam))]
+    return pd.concat(grids, axis=1)
+
+
 def main() -> None:
     if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
         t = contact_table([Path(a) for a in sys.argv[3:]])
@@ -376,8 +441,10 @@ def main() -> None:
             print(contact_runs(t).round(3).to_string(index=False))
             print(contact_fits(t).round(4).to_string(index=False))
         return
-    if len(sys.argv) > 3 and sys.argv[1] == "--windows":
+    if len(sys.argv) > 3 and sys.argv[1] in ("--windows", "--debris-windows"):
         t = window_table([Path(a) for a in sys.argv[3:]])
+        if sys.argv[1] == "--debris-windows":
+            t["case"] = t["case"].str.removesuffix("_debris")
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         with pd.option_context("display.width", 250, "display.max_columns", 40):
             print(window_fits(t).round(4).T.to_string())
@@ -416,9 +483,18 @@ def main() -> None:
             print(contact_fits().round(4).to_string(index=False))
         if (DEBRIS_DIR / "family_table.csv").is_file():
             print()
-            print("== S 100 mm with the loose grains deleted every 2000 steps (run.debris_removal_every)")
+            print("== with the loose grains deleted every 2000 steps (run.debris_removal_every)")
             print(debris_effect().round(3).T.to_string())
             print(debris_p_ratio().round(3).T.to_string())
+            if (pd.read_csv(DEBRIS_DIR / "family_table.csv")["packing_seed"] == 12345).sum() > 4:
+                print("-- the packing-12345 family with the loose grains deleted (F_n N; F_r/F_n)")
+                print(debris_family_grid().round(1).to_string())
+                print(debris_family_grid(metric="rolling_to_normal_ratio_1").round(3).to_string())
+                print(debris_family_fits().round(4).to_string())
+                print(debris_family_trends().round(3).T.to_string())
+            if DEBRIS_WINDOWS_CSV.is_file():
+                print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
+                print(window_fits(pd.read_csv(DEBRIS_WINDOWS_CSV)).round(4).T.to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

@@ -54,6 +54,8 @@ WINDOWS_CSV = HERE / "linear_windows.csv"
 #: the debris-removal runs of the packing-12345 family over the same windows, keyed by their family case (``--windows``
 #: on their parsed folders writes them as ``*_debris``; ``--debris-windows`` strips the suffix)
 DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
+#: report (``--variants``) of the narrow-block grain-size pair (session 37): lin_red_s100_p{1p9,7p6}_narrow{,_fine}
+NARROW_DIR = HERE / "linear_narrow"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
 CONTACTS_CSV = HERE / "linear_contacts.csv"
 #: report (``--variants``) of the family cases run with run.debris_removal_every (S 100 mm on packings 12345 and 202 in
@@ -433,6 +435,33 @@ def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_
     return pd.concat(grids, axis=1)
 
 
+def narrow_grain_pair() -> pd.DataFrame:
+    """The narrow unrelieved block (26 x 10 x 12 mm, S 100 mm) at p 1.9 and 7.6 mm with coarse (r 0.7-1.0 mm) and fine
+    (r 0.35-0.5 mm) grains (report ``linear_narrow``): per p and grain size F_n, F_r, F_r/F_n, grains, bonds broken,
+    grains inside, wall minutes and, from the contact census where it holds the runs, the grains touching the disc and
+    the share of its normal load that chips and debris carry; one row per grain size with p 7.6 / p 1.9 mm ratios."""
+    t = pd.read_csv(NARROW_DIR / "family_table.csv").set_index("variant_case")
+    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
+    rows = []
+    for size, tail in (("coarse", "_narrow"), ("fine", "_narrow_fine")):
+        row = {"grains": size}
+        for p in ("1p9", "7p6"):
+            name = f"lin_red_s100_p{p}{tail}"
+            r = t.loc[name]
+            for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
+                             ("rolling_to_normal_ratio_1", "F_r/F_n"), ("n_grains", "grains"),
+                             ("bonds_broken", "bonds broken"), ("broken_fraction_1", "broken fraction"),
+                             ("grains_inside_cutter_final", "inside")):
+                row[f"{short} p{p}"] = r[m]
+            row[f"wall min p{p}"] = r["wall_s"] / 60.0
+            for col, short in (("grains_touching", "touching"), ("detached_share_z_1", "detached share")):
+                row[f"{short} p{p}"] = means.loc[name, col] if name in means.index else float("nan")
+        row["F_n p7.6/p1.9"] = row["F_n N p7p6"] / row["F_n N p1p9"]
+        row["F_r/F_n p7.6/p1.9"] = row["F_r/F_n p7p6"] / row["F_r/F_n p1p9"]
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("grains")
+
+
 def main() -> None:
     if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
         t = contact_table([Path(a) for a in sys.argv[3:]])
@@ -495,6 +524,10 @@ def main() -> None:
             if DEBRIS_WINDOWS_CSV.is_file():
                 print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(window_fits(pd.read_csv(DEBRIS_WINDOWS_CSV)).round(4).T.to_string())
+        if (NARROW_DIR / "family_table.csv").is_file():
+            print()
+            print("== grain size on a narrow unrelieved block (S 100 mm, 26 x 10 x 12 mm)")
+            print(narrow_grain_pair().round(3).T.to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

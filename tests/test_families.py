@@ -1697,7 +1697,7 @@ def test_held_linear_family_without_its_loose_grains_loses_the_fall_with_p_and_t
     tr = mod.debris_family_trends()
     assert tr.loc["fr_fn_rises_with_p", ["debris change_1", "debris p_value"]].to_list() == pytest.approx([1.485, 0.089], abs=1e-3)
     assert tr.loc["fn_rises_with_s", ["debris change_1", "debris p_value"]].to_list() == pytest.approx([-0.067, 0.901], abs=1e-3)
-    # the p term stays flat over every window (family runs: -28.5 to -45.9 N/mm, all p < 0.001)
+    # the p term stays flat over every window (all 48 held family runs: -28.5 to -45.9 N/mm, all p < 0.001)
     w = mod.window_fits(pd.read_csv(mod.DEBRIS_WINDOWS_CSV))
     assert w["runs"].eq(16).all() and w["F_n p N/mm"].to_list() == pytest.approx([-2.789, -2.390, -1.515, -3.145], abs=1e-3)
     assert (w["F_n p p"] > 0.2).all()

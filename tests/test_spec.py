@@ -76,7 +76,7 @@ def test_case_files_hold_overrides_only(tmp_path):
         ("run:\n  debris_removal_every: -5\n", "run.debris_removal_every", "greater than or equal to 0"),
         ("bonds:\n  model: flat_joint\nengine: liggghts\n", "bonds.model", "flat_joint is a LAMMPS plugin"),
         ("specimen:\n  kind: cutting_block\npacking:\n  radius_min_mm: 0.35\n  radius_max_mm: 0.5\n", "cutter.shell_radius_mm",
-         "more than half of any grain radius the packing can have (0.245 mm)"),
+         "more than half the largest grain radius a packing can have (0.245 mm)"),
     ],
 )
 def test_bad_input_gives_one_clear_line(tmp_path, text, field, words):
@@ -96,7 +96,7 @@ def test_shell_radius_is_refused_before_packing_only_where_no_packing_can_pass(t
     never refuses a case the deck would take."""
     grains = "specimen:\n  kind: cutting_block\npacking:\n  radius_min_mm: 0.35\n  radius_max_mm: 0.5\n"
     assert load_case(write(tmp_path, grains + "cutter:\n  shell_radius_mm: 0.245\n")).cutter.shell_radius_mm == 0.245
-    with pytest.raises(SpecError, match=r"cutter\.shell_radius_mm: 0\.246 mm .*\(fix: at most half the smallest grain radius, 0\.171 mm\)"):
+    with pytest.raises(SpecError, match=r"cutter\.shell_radius_mm: 0\.246 mm .*\(fix: at most half the smallest grain radius, about 0\.171 mm; the packed grains set the exact limit\)"):
         load_case(write(tmp_path, grains + "cutter:\n  shell_radius_mm: 0.246\n"))
     # the LIGGGHTS decks cut with the STL mesh, not a shell of spheres
     assert load_case(write(tmp_path, grains + "engine: liggghts\nbonds:\n  enabled: false\n")).engine == "liggghts"

@@ -54,8 +54,9 @@ WINDOWS_CSV = HERE / "linear_windows.csv"
 #: the debris-removal runs of the packing-12345 family over the same windows, keyed by their family case (``--windows``
 #: on their parsed folders writes them as ``*_debris``; ``--debris-windows`` strips the suffix)
 DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
-#: report (``--variants``) of the narrow-block grain-size pair (session 37): lin_red_s100_p{1p9,7p6}_narrow{,_fine}
-NARROW_DIR = HERE / "linear_narrow"
+#: reports (``--variants``; one family case takes one variant per report) of the narrow-block grain-size pair (session
+#: 37): coarse grains lin_red_s100_p{1p9,7p6}_narrow, fine grains lin_red_s100_p{1p9,7p6}_narrow_fine
+NARROW_DIRS = {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
 CONTACTS_CSV = HERE / "linear_contacts.csv"
 #: report (``--variants``) of the family cases run with run.debris_removal_every (S 100 mm on packings 12345 and 202 in
@@ -392,9 +393,10 @@ def _debris_family_tables(packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFr
     deb = deb[deb["packing_seed"] == packing]
     fam = _held_linear()
     fam = fam[fam["case"].isin(deb["case"])]
-    if len(fam) != len(deb):
-        raise ValueError(f"{DEBRIS_DIR}: debris runs without a held family run: "
-                         f"{sorted(set(deb['case']) - set(fam['case']))}")
+    if len(fam) != len(deb) or deb["case"].duplicated().any():
+        raise ValueError(f"{DEBRIS_DIR}: each debris run needs one held family run; without one: "
+                         f"{sorted(set(deb['case']) - set(fam['case']))}, twice: "
+                         f"{sorted(set(deb.loc[deb['case'].duplicated(), 'case']))}")
     both = deb.merge(fam, on="case", suffixes=("", " family"))
     if ((both["n_grains"] != both["n_grains family"]) | (both["n_bonds_initial"] != both["n_bonds_initial family"])).any():
         raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
@@ -437,13 +439,14 @@ def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_
 
 def narrow_grain_pair() -> pd.DataFrame:
     """The narrow unrelieved block (26 x 10 x 12 mm, S 100 mm) at p 1.9 and 7.6 mm with coarse (r 0.7-1.0 mm) and fine
-    (r 0.35-0.5 mm) grains (report ``linear_narrow``): per p and grain size F_n, F_r, F_r/F_n, grains, bonds broken,
-    grains inside, wall minutes and, from the contact census where it holds the runs, the grains touching the disc and
-    the share of its normal load that chips and debris carry; one row per grain size with p 7.6 / p 1.9 mm ratios."""
-    t = pd.read_csv(NARROW_DIR / "family_table.csv").set_index("variant_case")
+    (r 0.35-0.5 mm) grains (reports :data:`NARROW_DIRS`): per p and grain size F_n, F_r, F_r/F_n, grains, bonds
+    broken, grains inside, wall minutes and, from the contact census where it holds the runs, the grains touching the
+    disc and the share of its normal load that chips and debris carry; one row per grain size with p 7.6 / p 1.9 mm
+    ratios."""
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
     for size, tail in (("coarse", "_narrow"), ("fine", "_narrow_fine")):
+        t = pd.read_csv(NARROW_DIRS[size] / "family_table.csv").set_index("variant_case")
         row = {"grains": size}
         for p in ("1p9", "7p6"):
             name = f"lin_red_s100_p{p}{tail}"
@@ -515,7 +518,8 @@ def main() -> None:
             print("== with the loose grains deleted every 2000 steps (run.debris_removal_every)")
             print(debris_effect().round(3).T.to_string())
             print(debris_p_ratio().round(3).T.to_string())
-            if (pd.read_csv(DEBRIS_DIR / "family_table.csv")["packing_seed"] == 12345).sum() > 4:
+            # session 36 ran two packing-12345 cases with the debris deleted; session 37 the other 14
+            if (pd.read_csv(DEBRIS_DIR / "family_table.csv")["packing_seed"] == 12345).sum() > 2:
                 print("-- the packing-12345 family with the loose grains deleted (F_n N; F_r/F_n)")
                 print(debris_family_grid().round(1).to_string())
                 print(debris_family_grid(metric="rolling_to_normal_ratio_1").round(3).to_string())
@@ -524,7 +528,7 @@ def main() -> None:
             if DEBRIS_WINDOWS_CSV.is_file():
                 print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(window_fits(pd.read_csv(DEBRIS_WINDOWS_CSV)).round(4).T.to_string())
-        if (NARROW_DIR / "family_table.csv").is_file():
+        if all((d / "family_table.csv").is_file() for d in NARROW_DIRS.values()):
             print()
             print("== grain size on a narrow unrelieved block (S 100 mm, 26 x 10 x 12 mm)")
             print(narrow_grain_pair().round(3).T.to_string())

@@ -1710,6 +1710,34 @@ def test_held_linear_family_without_its_loose_grains_loses_the_fall_with_p_and_t
     assert len(idle) == 16 and idle.between(2, 6).all() and half.groupby("case").size().eq(6).all()
 
 
+def test_held_linear_narrow_block_breaks_up_under_the_disc():
+    """docs/families_runs/shell_held/linear_narrow (session 37): session 31's unrelieved S 100 mm cut at p 1.9 and 7.6 mm
+    on a block 10 mm wide instead of 33 mm, with the r 0.16 mm shell that grains of r 0.35-0.5 mm need: the coarse half
+    of a grain-size pair whose fine half (lin_red_s100_p*_narrow_fine.yaml, ~65 min per run) was stopped for time. The
+    narrow block breaks up under the disc (38 and 51 % of its bonds, against 14 and 25 % on the 33 mm block) and carries
+    x0.07 and x0.12 of the 33 mm block's F_n, still falling with p (x0.79): a grain-size test needs the wider block."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_narrow.yaml", rec / f"lin_red_s100_p{p}_unrel.yaml") == {
+            ("specimen", "width_mm"): (10, 33), ("cutter", "shell_radius_mm"): (0.16, 0.3)}
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_narrow_fine.yaml", rec / f"lin_red_s100_p{p}_narrow.yaml") == {
+            ("packing", "radius_min_mm"): (0.35, 0.7), ("packing", "radius_max_mm"): (0.5, 1.0)}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    t = mod.narrow_grain_pair()
+    assert list(t.index) == ["coarse"]  # the fine pair did not run
+    c = t.loc["coarse"]
+    assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([22.528, 17.890, 0.794], abs=1e-3)
+    assert [c["broken fraction p1p9"], c["broken fraction p7p6"]] == pytest.approx([0.382, 0.511], abs=1e-3)
+    assert c["grains p1p9"] == c["grains p7p6"] == 763 and c["inside p1p9"] == c["inside p7p6"] == 0
+    wide = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_unrel" / "family_table.csv")
+    wide = wide.set_index("variant_case").loc[["lin_red_s100_p1p9_unrel", "lin_red_s100_p7p6_unrel"]]
+    assert (c[["F_n N p1p9", "F_n N p7p6"]].to_numpy() / wide["force_normal_N_mean_steady"].to_numpy()).tolist() == \
+        pytest.approx([0.066, 0.119], abs=1e-3)
+    assert wide["broken_fraction_1"].tolist() == pytest.approx([0.138, 0.249], abs=1e-3)
+
+
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
     """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
     (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved

@@ -1603,8 +1603,6 @@ def test_held_linear_disc_rides_on_loose_grains_and_its_force_follows_their_numb
     touch the disc at depth (-0.75 per reduced mm of p) and more at wide spacing (+0.21 per mm of S); with their number
     as a third term eq. 7's p and S terms vanish (p 0.63 and 0.96) and each grain adds 36.0 N. The fall of F_n with p
     is in every steady window, and grows towards the end of the travel (linear_windows.csv)."""
-    import pandas as pd
-
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     c = mod.contact_runs()
     assert len(c) == 48 and c["frames"].between(3, 6).all()
@@ -1624,9 +1622,7 @@ def test_held_linear_disc_rides_on_loose_grains_and_its_force_follows_their_numb
     s100 = ["lin_red_s100_p1p9", "lin_red_s100_p1p9_k202", "lin_red_s100_p7p6", "lin_red_s100_p7p6_k202"]
     d = mod.debris_effect()
     assert d.loc[s100, "detached share debris"].fillna(0).to_list() == pytest.approx([0.0, 0.0, 0.0, 0.25], abs=1e-3)
-    raw = pd.read_csv(mod.CONTACTS_CSV)
-    half = raw[raw["case"].isin([f"{c}_debris" for c in s100]) & (raw["cut_fraction_1"] >= 0.5)]
-    assert half.groupby("case")["force_z_hertz_N"].apply(lambda x: int((x == 0).sum())).to_dict() == {
+    assert mod.idle_dumps([f"{c}_debris" for c in s100])["idle"].to_dict() == {
         "lin_red_s100_p1p9_debris": 3, "lin_red_s100_p1p9_k202_debris": 6, "lin_red_s100_p7p6_debris": 3,
         "lin_red_s100_p7p6_k202_debris": 2}
     w = mod.window_fits()
@@ -1704,10 +1700,8 @@ def test_held_linear_family_without_its_loose_grains_loses_the_fall_with_p_and_t
     deleted = mod.debris_family_grid(metric="n_grains_deleted_debris")
     assert (deleted.loc[7.6, [f"debris S{s}" for s in (25, 51, 76, 100)]].to_numpy()
             > 1.3 * deleted.loc[1.9, [f"debris S{s}" for s in (25, 51, 76, 100)]].to_numpy()).all()
-    raw = pd.read_csv(mod.CONTACTS_CSV)
-    half = raw[raw["case"].isin([f"{n}_debris" for n in names]) & (raw["cut_fraction_1"] >= 0.5)]
-    idle = half.groupby("case")["force_z_hertz_N"].apply(lambda x: int((x == 0).sum()))
-    assert len(idle) == 16 and idle.between(2, 6).all() and half.groupby("case").size().eq(6).all()
+    idle = mod.idle_dumps([f"{n}_debris" for n in names])
+    assert len(idle) == 16 and idle["idle"].between(2, 6).all() and idle["dumps"].eq(6).all()
 
 
 def test_held_linear_narrow_block_breaks_up_under_the_disc():

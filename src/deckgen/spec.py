@@ -569,11 +569,12 @@ class Case(_Model):
                 # the LAMMPS deck holds the shell radius to half the packing's smallest grain radius once the packing
                 # exists (deck.render_case); above half the largest radius a grain can have after the bonding shrink,
                 # every packing fails that check, so say it here instead of after minutes of packing
-                r_top = p.radius_max_mm * (1.0 - self.bonds.shrink_before_bonding)
+                shrink = 1.0 - self.bonds.shrink_before_bonding
+                r_top = p.radius_max_mm * shrink
                 if cu.shell_radius_mm > 0.5 * r_top:
                     raise ValueError(f"cutter.shell_radius_mm: {cu.shell_radius_mm:g} mm is more than half the largest grain "
                                      f"radius a packing can have ({0.5 * r_top:.3g} mm) (fix: at most half the smallest "
-                                     f"grain radius, about {0.5 * p.radius_min_mm * (1.0 - self.bonds.shrink_before_bonding):.3g} mm; "
+                                     f"grain radius, about {0.5 * p.radius_min_mm * shrink:.3g} mm; "
                                      "the packed grains set the exact limit)")
         return self
 

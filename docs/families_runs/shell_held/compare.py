@@ -88,6 +88,13 @@ def _value(t: pd.DataFrame, name: str, col: str) -> float:
     return t.loc[name, col] if name in t.index else float("nan")
 
 
+def _same_grains_and_bonds(a: pd.DataFrame, b: pd.DataFrame) -> bool:
+    """Whether every row of ``a`` has the grain and initial bond counts of the row of ``b`` with the same index (the
+    two runs of a pair were rendered from one packing and one bond set)."""
+    b = b.reindex(a.index)
+    return bool(((a["n_grains"] == b["n_grains"]) & (a["n_bonds_initial"] == b["n_bonds_initial"])).all())
+
+
 def _held_linear() -> pd.DataFrame:
     """The report table of the held linear family runs (``linear``)."""
     return pd.read_csv(KINDS["linear"][1] / "family_table.csv")
@@ -117,7 +124,7 @@ def pairs(kind: str) -> pd.DataFrame:
     old = pd.read_csv(old_dir / "family_table.csv").set_index(key).reindex(new.index)
     if old["n_grains"].isna().any():
         raise ValueError(f"{old_dir}: no recorded run for {list(new.index[old['n_grains'].isna()])}")
-    if (old["n_grains"] != new["n_grains"]).any() or (old["n_bonds_initial"] != new["n_bonds_initial"]).any():
+    if not _same_grains_and_bonds(new, old):
         raise ValueError(f"{kind}: a held-shell run does not share its grains and bonds with the recorded run")
     out = pd.DataFrame(index=new.index)
     if "packing_seed" in new:
@@ -349,13 +356,12 @@ def debris_effect() -> pd.DataFrame:
     each debris run shares its grains and bonds with its family run."""
     fam = _held_linear().set_index("case")
     deb = pd.read_csv(DEBRIS_DIR / "family_table.csv").set_index("case")
+    if not _same_grains_and_bonds(deb, fam):
+        raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
     for case, d in deb.iterrows():
         f = fam.loc[case]
-        if (d["n_grains"], d["n_bonds_initial"]) != (f["n_grains"], f["n_bonds_initial"]):
-            raise ValueError(f"{DEBRIS_DIR}: {d['variant_case']} does not share its grains and bonds with the held run "
-                             f"of {case}")
         row = {"case": case, "packing_seed": int(d["packing_seed"]), "penetration_full_mm": d["penetration_full_mm"]}
         for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
                          ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken")):
@@ -397,8 +403,7 @@ def _debris_family_tables(packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFr
         raise ValueError(f"{DEBRIS_DIR}: each debris run needs one held family run; without one: "
                          f"{sorted(set(deb['case']) - set(fam['case']))}, twice: "
                          f"{sorted(set(deb.loc[deb['case'].duplicated(), 'case']))}")
-    both = deb.merge(fam, on="case", suffixes=("", " family"))
-    if ((both["n_grains"] != both["n_grains family"]) | (both["n_bonds_initial"] != both["n_bonds_initial family"])).any():
+    if not _same_grains_and_bonds(deb.set_index("case"), fam.set_index("case")):
         raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
     return fam, deb
 
@@ -435,6 +440,15 @@ def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_
     grids = [t.pivot_table(index="penetration_full_mm", columns="spacing_full_mm", values=metric).add_prefix(
         f"{which} S") for which, t in (("debris", deb), ("family", fam))]
     return pd.concat(grids, axis=1)
+
+
+def idle_dumps(cases: list[str], from_fraction: float = 0.5) -> pd.DataFrame:
+    """Per case of the contact census (names as they ran, e.g. ``*_debris``): at how many of its dumped steps from
+    ``from_fraction`` of the cut on the rebuilt normal force is 0 (the disc touches no grain), and of how many."""
+    raw = pd.read_csv(CONTACTS_CSV)
+    half = raw[raw["case"].isin(cases) & (raw["cut_fraction_1"] >= from_fraction)]
+    g = half.groupby("case")["force_z_hertz_N"]
+    return pd.DataFrame({"idle": g.apply(lambda x: int((x == 0).sum())), "dumps": g.size()})
 
 
 def narrow_grain_pair() -> pd.DataFrame:
@@ -519,10 +533,11 @@ def main() -> None:
         if (DEBRIS_DIR / "family_table.csv").is_file():
             print()
             print("== with the loose grains deleted every 2000 steps (run.debris_removal_every)")
-            print(debris_effect().round(3).T.to_string())
+            d = debris_effect()
+            print(d.round(3).T.to_string())
             print(debris_p_ratio().round(3).T.to_string())
             # session 36 ran two packing-12345 cases with the debris deleted; session 37 the other 14
-            if (pd.read_csv(DEBRIS_DIR / "family_table.csv")["packing_seed"] == 12345).sum() > 2:
+            if (d["packing_seed"] == 12345).sum() > 2:
                 print("-- the packing-12345 family with the loose grains deleted (F_n N; F_r/F_n)")
                 print(debris_family_grid().round(1).to_string())
                 print(debris_family_grid(metric="rolling_to_normal_ratio_1").round(3).to_string())

@@ -1719,9 +1719,9 @@ def test_held_linear_narrow_block_breaks_up_under_the_disc():
         assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_narrow_fine.yaml", rec / f"lin_red_s100_p{p}_narrow.yaml") == {
             ("packing", "radius_min_mm"): (0.35, 0.7), ("packing", "radius_max_mm"): (0.5, 1.0)}
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
-    t = mod.narrow_grain_pair()
-    assert list(t.index) == ["coarse"]  # the fine pair did not run
-    c = t.loc["coarse"]
+    t = mod.grain_pairs()
+    assert (10, "fine") not in t.index  # the fine pair was stopped for time
+    c = t.loc[(10, "coarse")]
     assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([22.528, 17.890, 0.794], abs=1e-3)
     assert [c["broken fraction p1p9"], c["broken fraction p7p6"]] == pytest.approx([0.382, 0.511], abs=1e-3)
     assert c["grains p1p9"] == c["grains p7p6"] == 763 and c["inside p1p9"] == c["inside p7p6"] == 0
@@ -1730,6 +1730,33 @@ def test_held_linear_narrow_block_breaks_up_under_the_disc():
     assert (c[["F_n N p1p9", "F_n N p7p6"]].to_numpy() / wide["force_normal_N_mean_steady"].to_numpy()).tolist() == \
         pytest.approx([0.066, 0.119], abs=1e-3)
     assert wide["broken_fraction_1"].tolist() == pytest.approx([0.138, 0.249], abs=1e-3)
+
+
+def test_held_linear_20mm_block_splits_a_side_off_where_the_33mm_block_holds():
+    """docs/families_runs/shell_held/linear_w20 (session 38): the narrow pair on a block 20 mm wide instead of 10 mm
+    (coarse grains). Until about half the cut F_n follows the 33 mm block's (115 against 117 N at p 1.9 mm over the
+    window 0.1-0.3 of the block); then a side of the block, half its width and its whole height, splits off (largest
+    chip 122 and 70 grains, against 9 and 33 on the 33 mm block) and F_n in the case's window is x0.10 and x0.40 of
+    the 33 mm block's. Because the split comes earlier at p 7.6 mm, F_n there rises with p (x1.80), where on the 33 mm
+    block it falls (x0.44)."""
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p in ("1p9", "7p6"):
+        for g in ("", "_fine"):
+            assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_w20{g}.yaml", rec / f"lin_red_s100_p{p}_narrow{g}.yaml") == {
+                ("specimen", "width_mm"): (20, 10)}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    c = mod.grain_pairs().loc[(20, "coarse")]
+    assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([33.699, 60.541, 1.797], abs=1e-3)
+    assert c["grains p1p9"] == c["grains p7p6"] == 1523 and c["inside p1p9"] == c["inside p7p6"] == 0
+    # a side split off: the largest chip spans half the block's width and all its height
+    assert [c["largest chip grains p1p9"], c["largest chip grains p7p6"]] == [122, 70]
+    assert min(c["largest chip y mm p1p9"], c["largest chip y mm p7p6"]) > 10.0
+    assert min(c["largest chip z mm p1p9"], c["largest chip z mm p7p6"]) > 12.0
+    w = mod.grain_pair_windows()
+    wide, w20 = w.loc["lin_red_s100_p1p9_unrel"], w.loc["lin_red_s100_p1p9_w20"]
+    assert w20[0.1] / wide[0.1] == pytest.approx(0.986, abs=1e-3)  # before the split: the 33 mm block's F_n
+    assert w20[0.4] / wide[0.4] == pytest.approx(0.099, abs=1e-3)  # the case's window, after it
+    assert (w.loc["lin_red_s100_p7p6_w20"] / w.loc["lin_red_s100_p7p6_unrel"]).max() < 0.41  # split before the first window
 
 
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():

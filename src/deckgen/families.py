@@ -824,7 +824,8 @@ TABLE_FIELDS = [
     "cycles_averaged_1", "torque_axis_Nm_mean_steady", "force_normal_N_peak", "force_rolling_N_peak",
     "force_side_N_peak", "force_magnitude_N_peak", "rolling_to_normal_ratio_1", "velocity_ratio_nu_1",
     "contact_fraction_steady_1", "bonds_broken", "broken_fraction_1", "bonds_broken_tension", "bonds_broken_shear",
-    "chips_count", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
+    "chips_count", "largest_chip_grains", "largest_chip_volume_m3", "largest_chip_extent_x_m",
+    "largest_chip_extent_y_m", "largest_chip_extent_z_m", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
     "specific_energy_kinematic_J_m3", "grains_inside_cutter_final", "n_grains_deleted_debris",
 ]
 

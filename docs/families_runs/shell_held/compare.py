@@ -54,9 +54,14 @@ WINDOWS_CSV = HERE / "linear_windows.csv"
 #: the debris-removal runs of the packing-12345 family over the same windows, keyed by their family case (``--windows``
 #: on their parsed folders writes them as ``*_debris``; ``--debris-windows`` strips the suffix)
 DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
-#: reports (``--variants``; one family case takes one variant per report) of the narrow-block grain-size pair (session
-#: 37): coarse grains lin_red_s100_p{1p9,7p6}_narrow, fine grains lin_red_s100_p{1p9,7p6}_narrow_fine
-NARROW_DIRS = {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}
+#: the grain-size pairs on narrowed unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), by block width in mm: the case-name
+#: tail of the coarse-grain runs (r 0.7-1.0 mm; the fine ones, r 0.35-0.5 mm, add ``_fine``) and the reports
+#: (``--variants``; one family case takes one variant per report, so one report per grain size). 10 mm: session 37
+#: (the fine pair stopped for time); 20 mm: session 38
+GRAIN_PAIRS = {10: ("_narrow", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
+               20: ("_w20", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"})}
+#: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
+PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
 CONTACTS_CSV = HERE / "linear_contacts.csv"
 #: report (``--variants``) of the family cases run with run.debris_removal_every (S 100 mm on packings 12345 and 202 in
@@ -451,35 +456,49 @@ def idle_dumps(cases: list[str], from_fraction: float = 0.5) -> pd.DataFrame:
     return pd.DataFrame({"idle": g.apply(lambda x: int((x == 0).sum())), "dumps": g.size()})
 
 
-def narrow_grain_pair() -> pd.DataFrame:
-    """The narrow unrelieved block (26 x 10 x 12 mm, S 100 mm) at p 1.9 and 7.6 mm with coarse (r 0.7-1.0 mm) and fine
-    (r 0.35-0.5 mm) grains (reports :data:`NARROW_DIRS`): per p and grain size F_n, F_r, F_r/F_n, grains, bonds
-    broken, grains inside, wall minutes and, from the contact census where it holds the runs, the grains touching the
-    disc and the share of its normal load that chips and debris carry; one row per grain size with p 7.6 / p 1.9 mm
-    ratios; only the grain sizes whose report exists (session 37 ran the coarse pair; the fine runs, ~65 min each, were
-    stopped for time)."""
+def grain_pairs() -> pd.DataFrame:
+    """The grain-size pairs of :data:`GRAIN_PAIRS`: session 31's unrelieved S 100 mm cut at p 1.9 and 7.6 mm on blocks
+    26 x W x 12 mm with coarse (r 0.7-1.0 mm) and fine (r 0.35-0.5 mm) grains, both with the r 0.16 mm shell. Per block
+    width W and grain size, per p: F_n, F_r, F_r/F_n, grains, bonds broken and their fraction, grains inside, wall
+    minutes, the largest chip (grains, y and z extent in mm) and, from the contact census where it holds the runs, the
+    grains touching the disc and the share of its normal load that chips and debris carry; with p 7.6 / p 1.9 mm ratios;
+    only the reports that exist (session 37's 10 mm fine pair, ~65 min per run, was stopped for time). Index
+    (width_mm, grains)."""
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
-    for size, tail in (("coarse", "_narrow"), ("fine", "_narrow_fine")):
-        if not (NARROW_DIRS[size] / "family_table.csv").is_file():
-            continue
-        t = pd.read_csv(NARROW_DIRS[size] / "family_table.csv").set_index("variant_case")
-        row = {"grains": size}
-        for p in ("1p9", "7p6"):
-            name = f"lin_red_s100_p{p}{tail}"
-            r = t.loc[name]
-            for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
-                             ("rolling_to_normal_ratio_1", "F_r/F_n"), ("n_grains", "grains"),
-                             ("bonds_broken", "bonds broken"), ("broken_fraction_1", "broken fraction"),
-                             ("grains_inside_cutter_final", "inside")):
-                row[f"{short} p{p}"] = r[m]
-            row[f"wall min p{p}"] = r["wall_s"] / 60.0
-            for col, short in (("grains_touching", "touching"), ("detached_share_z_1", "detached share")):
-                row[f"{short} p{p}"] = means.loc[name, col] if name in means.index else float("nan")
-        row["F_n p7.6/p1.9"] = row["F_n N p7p6"] / row["F_n N p1p9"]
-        row["F_r/F_n p7.6/p1.9"] = row["F_r/F_n p7p6"] / row["F_r/F_n p1p9"]
-        rows.append(row)
-    return pd.DataFrame(rows).set_index("grains")
+    for width, (tail, dirs) in GRAIN_PAIRS.items():
+        for size, suffix in (("coarse", ""), ("fine", "_fine")):
+            if not (dirs[size] / "family_table.csv").is_file():
+                continue
+            t = pd.read_csv(dirs[size] / "family_table.csv").set_index("variant_case")
+            row = {"width_mm": width, "grains": size}
+            for p in ("1p9", "7p6"):
+                name = f"lin_red_s100_p{p}{tail}{suffix}"
+                r = t.loc[name]
+                for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
+                                 ("rolling_to_normal_ratio_1", "F_r/F_n"), ("n_grains", "grains"),
+                                 ("bonds_broken", "bonds broken"), ("broken_fraction_1", "broken fraction"),
+                                 ("grains_inside_cutter_final", "inside")):
+                    row[f"{short} p{p}"] = r[m]
+                row[f"wall min p{p}"] = r["wall_s"] / 60.0
+                # the largest chip: a side of the block split off (session 38) spans the half-width and the height
+                row[f"largest chip grains p{p}"] = r["largest_chip_grains"]
+                for ax in "yz":
+                    row[f"largest chip {ax} mm p{p}"] = r[f"largest_chip_extent_{ax}_m"] * 1e3
+                for col, short in (("grains_touching", "touching"), ("detached_share_z_1", "detached share")):
+                    row[f"{short} p{p}"] = means.loc[name, col] if name in means.index else float("nan")
+            row["F_n p7.6/p1.9"] = row["F_n N p7p6"] / row["F_n N p1p9"]
+            row["F_r/F_n p7.6/p1.9"] = row["F_r/F_n p7p6"] / row["F_r/F_n p1p9"]
+            rows.append(row)
+    return pd.DataFrame(rows).set_index(["width_mm", "grains"])
+
+
+def grain_pair_windows(windows: pd.DataFrame | None = None) -> pd.DataFrame:
+    """F_n (N) of the grain-size pairs' runs and of the 33 mm unrelieved block's over the windows of
+    :data:`PATCH_WINDOWS` (rows: case; columns: the window's contact-patch start as a fraction of the block, ``lo``):
+    whether F_n before a side of the block splits off follows the 33 mm block's, and where along the cut it drops."""
+    w = pd.read_csv(PAIR_WINDOWS_CSV) if windows is None else windows
+    return w.pivot_table(index="case", columns="patch_lo_1", values="force_normal_N_mean_steady")
 
 
 def main() -> None:
@@ -489,6 +508,11 @@ def main() -> None:
         with pd.option_context("display.width", 250, "display.max_columns", 40):
             print(contact_runs(t).round(3).to_string(index=False))
             print(contact_fits(t).round(4).to_string(index=False))
+        return
+    if len(sys.argv) > 3 and sys.argv[1] == "--pair-windows":
+        t = window_table([Path(a) for a in sys.argv[3:]])
+        t.to_csv(sys.argv[2], index=False, float_format="%.6g")
+        print(grain_pair_windows(t).round(1).to_string())
         return
     if len(sys.argv) > 3 and sys.argv[1] in ("--windows", "--debris-windows"):
         t = window_table([Path(a) for a in sys.argv[3:]])
@@ -546,10 +570,13 @@ def main() -> None:
             if DEBRIS_WINDOWS_CSV.is_file():
                 print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(window_fits(pd.read_csv(DEBRIS_WINDOWS_CSV)).round(4).T.to_string())
-        if any((d / "family_table.csv").is_file() for d in NARROW_DIRS.values()):
+        if any((d / "family_table.csv").is_file() for _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
             print()
-            print("== grain size on a narrow unrelieved block (S 100 mm, 26 x 10 x 12 mm)")
-            print(narrow_grain_pair().round(3).T.to_string())
+            print("== grain size on narrowed unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm: report linear_unrel)")
+            print(grain_pairs().round(3).T.to_string())
+            if PAIR_WINDOWS_CSV.is_file():
+                print("-- F_n N over windows of the cut (contact-patch centre from lo to lo + 0.2 of the block)")
+                print(grain_pair_windows().round(1).to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

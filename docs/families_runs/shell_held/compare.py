@@ -10,13 +10,18 @@ motion of the shell. Session 35 added 16 linear family cases (22 in ``linear``),
 block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair with) and a 24 mm high block
 (``linear_h24``, new). Session 36 brought ``linear`` to 43 cases and added the contact census, the windows and the
 S 100 mm debris-removal runs (``linear_debris``); session 37 the last five cases (48) and the whole packing-12345
-family with run.debris_removal_every.
+family with run.debris_removal_every; session 38 the grain-size pairs by block width (``GRAIN_PAIRS``) and the family
+cases with the side faces held (``linear_yfix``).
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
     python docs/families_runs/shell_held/compare.py --debris-windows docs/families_runs/shell_held/linear_debris_windows.csv \
         <parsed of the packing-12345 debris-removal runs>...
     python docs/families_runs/shell_held/compare.py --contacts docs/families_runs/shell_held/linear_contacts.csv <X>...
+    python docs/families_runs/shell_held/compare.py --pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv \
+        <parsed of the 33 mm unrelieved, narrow and 20 mm runs>...
+
+(``--windows``, ``--debris-windows`` and ``--pair-windows`` overwrite their CSV with the runs passed alone.)
 
 Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
 its 95 % interval (``../rotary_shell0p5/compare.py``'s ``gain_row``); then, where both shells ran on the fixed deck,
@@ -67,6 +72,8 @@ CONTACTS_CSV = HERE / "linear_contacts.csv"
 #: report (``--variants``) of the family cases run with run.debris_removal_every (S 100 mm on packings 12345 and 202 in
 #: session 36; the whole packing-12345 family in session 37)
 DEBRIS_DIR = HERE / "linear_debris"
+#: report (``--variants``) of the family cases run with specimen.fixed_faces zmin, xmax, ymin, ymax (session 38)
+YFIX_DIR = HERE / "linear_yfix"
 
 
 def load_gain_row():
@@ -215,6 +222,28 @@ def regression_same_cases(min_p_full_mm: float = 0.0) -> pd.DataFrame:
         r = family_regression("linear_ccs", table).set_index(["response", "term"])[cols]
         out.append(r.add_prefix(f"{which} "))
     return pd.concat(out, axis=1)
+
+
+#: a chip of at least this many grains (about 4 % of a family block's ~2400 grains) counts as a large piece broken off
+LARGE_CHIP_GRAINS = 100
+
+
+def large_chip_fit() -> pd.DataFrame:
+    """On the 48 held linear runs (free side faces): how many leave a chip of at least :data:`LARGE_CHIP_GRAINS`
+    grains, per full-scale p, and seed 001's eq. 7 form for F_n with and without that indicator as a third term
+    (OLS; estimate and p per term): whether the runs that break a large piece off make F_n fall with p."""
+    import statsmodels.formula.api as smf
+
+    t = _held_linear().assign(S=lambda d: d["spacing_mm"], p=lambda d: d["penetration_mm"],
+                              Fn=lambda d: d["force_normal_N_mean_steady"],
+                              large=lambda d: (d["largest_chip_grains"] >= LARGE_CHIP_GRAINS).astype(int))
+    rows = [{"model": f"large chips at p {p:g} mm", "term": "runs", "estimate": float(g["large"].sum()),
+             "p_value": float("nan")} for p, g in t.groupby("penetration_full_mm")]
+    for formula in ("Fn ~ S + p", "Fn ~ S + p + large", "large ~ S + p"):
+        fit = smf.ols(formula, t).fit()
+        rows += [{"model": formula, "term": k, "estimate": float(fit.params[k]), "p_value": float(fit.pvalues[k])}
+                 for k in fit.params.index]
+    return pd.DataFrame(rows).set_index(["model", "term"])
 
 
 def fn_p_ratio() -> pd.DataFrame:
@@ -396,55 +425,117 @@ def debris_p_ratio() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("packing_seed")
 
 
-def _debris_family_tables(packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(held family runs, debris-removal runs) of the linear family cases of ``packing`` that ran with
-    run.debris_removal_every (report ``linear_debris``), the family table cut to the same cases; the debris table keyed
-    by the family case, as the family's trend and regression code reads it."""
-    deb = pd.read_csv(DEBRIS_DIR / "family_table.csv")
-    deb = deb[deb["packing_seed"] == packing]
+def _variant_family_tables(report: Path = DEBRIS_DIR, packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(held family runs, variant runs) of the linear family cases of ``packing`` that ran as the variants of report
+    ``report`` (``linear_debris``: run.debris_removal_every; ``linear_yfix``: side faces held), the family table cut to
+    the same cases; the variant table keyed by the family case, as the family's trend and regression code reads it.
+    Raises unless each variant run has one held family run and shares its grains and bonds."""
+    var = pd.read_csv(report / "family_table.csv")
+    var = var[var["packing_seed"] == packing]
     fam = _held_linear()
-    fam = fam[fam["case"].isin(deb["case"])]
-    if len(fam) != len(deb) or deb["case"].duplicated().any():
-        raise ValueError(f"{DEBRIS_DIR}: each debris run needs one held family run; without one: "
-                         f"{sorted(set(deb['case']) - set(fam['case']))}, twice: "
-                         f"{sorted(set(deb.loc[deb['case'].duplicated(), 'case']))}")
-    if not _same_grains_and_bonds(deb.set_index("case"), fam.set_index("case")):
-        raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
-    return fam, deb
+    fam = fam[fam["case"].isin(var["case"])]
+    if len(fam) != len(var) or var["case"].duplicated().any():
+        raise ValueError(f"{report}: each variant run needs one held family run; without one: "
+                         f"{sorted(set(var['case']) - set(fam['case']))}, twice: "
+                         f"{sorted(set(var.loc[var['case'].duplicated(), 'case']))}")
+    if not _same_grains_and_bonds(var.set_index("case"), fam.set_index("case")):
+        raise ValueError(f"{report}: a variant run does not share its grains and bonds with its held family run")
+    return fam, var
 
 
-def debris_family_fits(packing: int = 12345) -> pd.DataFrame:
-    """Seed 001's eq. 7 form (``deckgen.families.family_regression``) on the debris-removal runs of ``packing`` and on
-    the held family runs of the same cases, side by side (estimate, p, R^2 per response and term): whether F_n still
-    falls with p and rises with S once the loose grains leave the cut."""
+def variant_family_fits(report: Path = DEBRIS_DIR, label: str = "debris", packing: int = 12345) -> pd.DataFrame:
+    """Seed 001's eq. 7 form (``deckgen.families.family_regression``) on the variant runs of ``report`` on ``packing``
+    (columns prefixed ``label``) and on the held family runs of the same cases (``family``), side by side (estimate,
+    p, R^2 per response and term)."""
     from deckgen.families import family_regression
 
     cols = ["estimate", "std_error", "p_value", "r_squared", "n_runs"]
-    fam, deb = _debris_family_tables(packing)
+    fam, var = _variant_family_tables(report, packing)
     out = [family_regression("linear_ccs", t).set_index(["response", "term"])[cols].add_prefix(f"{which} ")
-           for which, t in (("family", fam), ("debris", deb))]
+           for which, t in (("family", fam), (label, var))]
     return pd.concat(out, axis=1)
 
 
-def debris_family_trends(packing: int = 12345) -> pd.DataFrame:
-    """The family's trends (``deckgen.families.trend_table``) on the debris-removal runs of ``packing`` and on the held
-    family runs of the same cases, side by side."""
+def variant_family_trends(report: Path = DEBRIS_DIR, label: str = "debris", packing: int = 12345) -> pd.DataFrame:
+    """The family's trends (``deckgen.families.trend_table``) on the variant runs of ``report`` on ``packing`` and on
+    the held family runs of the same cases, side by side."""
     from deckgen.families import trend_table
 
     cols = ["runs", "change_1", "change_1_ci95_low", "change_1_ci95_high", "p_value", "seed_change_1"]
-    fam, deb = _debris_family_tables(packing)
+    fam, var = _variant_family_tables(report, packing)
     out = [trend_table("linear_ccs", t).set_index("trend")[cols].add_prefix(f"{which} ")
-           for which, t in (("family", fam), ("debris", deb))]
+           for which, t in (("family", fam), (label, var))]
     return pd.concat(out, axis=1)
 
 
-def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_steady") -> pd.DataFrame:
-    """``metric`` of the debris-removal runs of ``packing`` as a table: full-scale p down, S across, and beside it the
-    held family run's value (columns ``family S..``)."""
-    fam, deb = _debris_family_tables(packing)
+def variant_family_grid(report: Path = DEBRIS_DIR, label: str = "debris", packing: int = 12345,
+                        metric: str = "force_normal_N_mean_steady") -> pd.DataFrame:
+    """``metric`` of the variant runs of ``report`` on ``packing`` as a table: full-scale p down, S across (columns
+    ``<label> S..``), and beside it the held family run's value (``family S..``)."""
+    fam, var = _variant_family_tables(report, packing)
     grids = [t.pivot_table(index="penetration_full_mm", columns="spacing_full_mm", values=metric).add_prefix(
-        f"{which} S") for which, t in (("debris", deb), ("family", fam))]
+        f"{which} S") for which, t in ((label, var), ("family", fam))]
     return pd.concat(grids, axis=1)
+
+
+def debris_family_fits(packing: int = 12345) -> pd.DataFrame:
+    """:func:`variant_family_fits` of the debris-removal runs (report ``linear_debris``): whether F_n still falls with p
+    and rises with S once the loose grains leave the cut."""
+    return variant_family_fits(DEBRIS_DIR, "debris", packing)
+
+
+def debris_family_trends(packing: int = 12345) -> pd.DataFrame:
+    """:func:`variant_family_trends` of the debris-removal runs."""
+    return variant_family_trends(DEBRIS_DIR, "debris", packing)
+
+
+def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_steady") -> pd.DataFrame:
+    """:func:`variant_family_grid` of the debris-removal runs."""
+    return variant_family_grid(DEBRIS_DIR, "debris", packing, metric)
+
+
+def yfix_effect() -> pd.DataFrame:
+    """Every case of report ``linear_yfix`` (session 38: the family cases with specimen.fixed_faces zmin, xmax, ymin,
+    ymax, seed 001's boundary) beside its held family run (free side faces): F_n, F_r, F_r/F_n, bonds broken, the
+    largest chip (grains, y and z extent in mm) and grains inside; held sides / free sides. Raises unless each pair
+    shares its grains and bonds."""
+    fam = _held_linear().set_index("case")
+    var = pd.read_csv(YFIX_DIR / "family_table.csv").set_index("case")
+    if not _same_grains_and_bonds(var, fam):
+        raise ValueError(f"{YFIX_DIR}: a run does not share its grains and bonds with its held family run")
+    rows = []
+    for case, v in var.iterrows():
+        f = fam.loc[case]
+        row = {"case": case, "packing_seed": int(v["packing_seed"]), "spacing_full_mm": v["spacing_full_mm"],
+               "penetration_full_mm": v["penetration_full_mm"]}
+        for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
+                         ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken"),
+                         ("largest_chip_grains", "largest chip")):
+            row[f"{short} free"], row[f"{short} held"] = f[m], v[m]
+            row[f"{short} held/free"] = v[m] / f[m]
+        for ax in "yz":
+            for which, t in (("free", f), ("held", v)):
+                row[f"largest chip {ax} mm {which}"] = t[f"largest_chip_extent_{ax}_m"] * 1e3
+        row["inside free"], row["inside held"] = f["grains_inside_cutter_final"], v["grains_inside_cutter_final"]
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("case")
+
+
+def yfix_p_ratio() -> pd.DataFrame:
+    """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), free and held side faces."""
+    t = yfix_effect()
+    t = t[t["spacing_full_mm"] == 100]
+    rows = []
+    for k, g in t.groupby("packing_seed"):
+        g = g.set_index("penetration_full_mm")
+        if not {1.9, 7.6} <= set(g.index):
+            continue
+        row = {"packing_seed": k}
+        for which in ("free", "held"):
+            row[f"F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_n N {which}"] / g.loc[1.9, f"F_n N {which}"]
+            row[f"F_r/F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_r/F_n {which}"] / g.loc[1.9, f"F_r/F_n {which}"]
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing_seed")
 
 
 def idle_dumps(cases: list[str], from_fraction: float = 0.5) -> pd.DataFrame:
@@ -498,7 +589,7 @@ def grain_pair_windows(windows: pd.DataFrame | None = None) -> pd.DataFrame:
     :data:`PATCH_WINDOWS` (rows: case; columns: the window's contact-patch start as a fraction of the block, ``lo``):
     whether F_n before a side of the block splits off follows the 33 mm block's, and where along the cut it drops."""
     w = pd.read_csv(PAIR_WINDOWS_CSV) if windows is None else windows
-    return w.pivot_table(index="case", columns="patch_lo_1", values="force_normal_N_mean_steady")
+    return w.pivot(index="case", columns="patch_lo_1", values="force_normal_N_mean_steady")  # raises on a case twice
 
 
 def main() -> None:
@@ -549,6 +640,8 @@ def main() -> None:
             print(regression_same_cases().round(4).to_string())
             print("-- without the p 1.9 mm cells")
             print(regression_same_cases(2.0).round(4).to_string())
+            print("-- with a chip of >= 100 grains (a large piece of the block broken off) as a third term")
+            print(large_chip_fit().round(4).to_string())
         if CONTACTS_CSV.is_file():
             print()
             print("== what carries the disc's load on the held linear runs (deckgen.contacts, second half of the cut)")
@@ -570,6 +663,18 @@ def main() -> None:
             if DEBRIS_WINDOWS_CSV.is_file():
                 print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(window_fits(pd.read_csv(DEBRIS_WINDOWS_CSV)).round(4).T.to_string())
+        if (YFIX_DIR / "family_table.csv").is_file():
+            print()
+            print("== with the side faces y min, y max held as well (seed 001's boundary; report linear_yfix)")
+            y = yfix_effect()
+            print(y.round(3).T.to_string())
+            print(yfix_p_ratio().round(3).T.to_string())
+            if (y["packing_seed"] == 12345).sum() >= 6:
+                print("-- the packing-12345 cases with the side faces held (F_n N; F_r/F_n)")
+                print(variant_family_grid(YFIX_DIR, "held").round(1).to_string())
+                print(variant_family_grid(YFIX_DIR, "held", metric="rolling_to_normal_ratio_1").round(3).to_string())
+                print(variant_family_fits(YFIX_DIR, "held").round(4).to_string())
+                print(variant_family_trends(YFIX_DIR, "held").round(3).T.to_string())
         if any((d / "family_table.csv").is_file() for _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
             print()
             print("== grain size on narrowed unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm: report linear_unrel)")

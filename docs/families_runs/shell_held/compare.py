@@ -410,19 +410,26 @@ def debris_effect() -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("case")
 
 
-def debris_p_ratio() -> pd.DataFrame:
-    """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), family runs and debris-removal runs."""
-    t = debris_effect()
-    t = t[[c.startswith("lin_red_s100_") for c in t.index]]
+def _s100_p_ratio(effect: pd.DataFrame, labels: tuple[str, str]) -> pd.DataFrame:
+    """Per packing of an effect table (:func:`debris_effect`, :func:`yfix_effect`): F_n and F_r/F_n at p 7.6 / p 1.9 mm
+    (S 100 mm) for each of the two ``labels`` (its column suffixes); packings without both depths are left out."""
+    t = effect[[c.startswith("lin_red_s100_") for c in effect.index]]
     rows = []
     for k, g in t.groupby("packing_seed"):
         g = g.set_index("penetration_full_mm")
+        if not {1.9, 7.6} <= set(g.index):
+            continue
         row = {"packing_seed": k}
-        for which in ("family", "debris"):
+        for which in labels:
             row[f"F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_n N {which}"] / g.loc[1.9, f"F_n N {which}"]
             row[f"F_r/F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_r/F_n {which}"] / g.loc[1.9, f"F_r/F_n {which}"]
         rows.append(row)
     return pd.DataFrame(rows).set_index("packing_seed")
+
+
+def debris_p_ratio() -> pd.DataFrame:
+    """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), family runs and debris-removal runs."""
+    return _s100_p_ratio(debris_effect(), ("family", "debris"))
 
 
 def _variant_family_tables(report: Path = DEBRIS_DIR, packing: int = 12345) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -523,19 +530,7 @@ def yfix_effect() -> pd.DataFrame:
 
 def yfix_p_ratio() -> pd.DataFrame:
     """Per packing: F_n and F_r/F_n at p 7.6 / p 1.9 mm (S 100 mm), free and held side faces."""
-    t = yfix_effect()
-    t = t[t["spacing_full_mm"] == 100]
-    rows = []
-    for k, g in t.groupby("packing_seed"):
-        g = g.set_index("penetration_full_mm")
-        if not {1.9, 7.6} <= set(g.index):
-            continue
-        row = {"packing_seed": k}
-        for which in ("free", "held"):
-            row[f"F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_n N {which}"] / g.loc[1.9, f"F_n N {which}"]
-            row[f"F_r/F_n p7.6/p1.9 {which}"] = g.loc[7.6, f"F_r/F_n {which}"] / g.loc[1.9, f"F_r/F_n {which}"]
-        rows.append(row)
-    return pd.DataFrame(rows).set_index("packing_seed")
+    return _s100_p_ratio(yfix_effect(), ("free", "held"))
 
 
 def idle_dumps(cases: list[str], from_fraction: float = 0.5) -> pd.DataFrame:

@@ -1737,8 +1737,9 @@ def test_held_linear_20mm_block_splits_a_side_off_where_the_33mm_block_holds():
     (coarse grains). In the first window (contact patch over 0.1-0.3 of the block) F_n at p 1.9 mm is the 33 mm
     block's (115 against 117 N; x0.81 over 0.2-0.4, x0.44 over 0.3-0.5); then a side of the block, half its width and
     its whole height, splits off (largest chip 122 and 70 grains, against 9 and 33 on the 33 mm block, packing 12345)
-    and F_n in the case's window is x0.10 and x0.40 of the 33 mm block's. Because the split comes earlier at p 7.6 mm, F_n there rises with p (x1.80), where on the 33 mm
-    block it falls (x0.44)."""
+    and F_n in the case's window is x0.10 and x0.40 of the 33 mm block's (x0.24-0.40 in every window at p 7.6 mm).
+    Because the split comes earlier at p 7.6 mm, F_n there rises with p (x1.80), where on the 33 mm block it falls
+    (x0.44)."""
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
     for p in ("1p9", "7p6"):
         for g in ("", "_fine"):

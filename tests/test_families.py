@@ -1781,6 +1781,46 @@ def test_held_linear_large_chips_do_not_make_the_fall_with_p():
     assert f.loc[("large ~ S + p", "p"), "p_value"] > 0.5
 
 
+def test_held_linear_family_with_its_sides_held_still_loses_force_with_p():
+    """docs/families_runs/shell_held/linear_yfix (session 38): all 16 packing-12345 family cases with the side faces
+    y min and y max held as well (seed 001 restrains its block at the bottom and the lateral faces), nothing else
+    changed. No large piece breaks off any more (largest chip at most 39 grains; free sides: 5 runs of 100-381), and
+    F_n is x1.39 of the free-sided runs' (geometric mean, 95 % interval 0.92-2.08; x0.33-5.8 case by case). But F_n
+    still falls with p: eq. 7's p term -48.3 N/mm (p 0.15; free -67.4, p 0.001), and over the earlier windows -44.8
+    and -57.7 N/mm at p < 0.01. The rise with S and the rise of F_r/F_n with p lose their significance (p 0.34 and
+    0.44). So the free sides are not what makes F_n fall with p."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    names = [f"lin_red_s{s}_p{p}" for s in (25, 51, 76, 100) for p in ("1p9", "3p8", "6p4", "7p6")]
+    for name in names:
+        assert _diagnostic_changes(rec / f"{name}_yfix.yaml", ROOT / "cases" / "linear_ccs" / "reduced" / f"{name}.yaml") == {
+            ("specimen", "fixed_faces"): (["zmin", "xmax", "ymin", "ymax"], ["zmin", "xmax"])}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    y = mod.yfix_effect()  # raises unless each run shares its grains and bonds with its free-sided family run
+    y = y[y["packing_seed"] == 12345]
+    assert sorted(y.index) == sorted(names)
+    assert y["largest chip held"].max() == 39 and int((y["largest chip free"] >= 100).sum()) == 5
+    g = mod.load_gain_row()("held/free", y["F_n N held/free"])
+    assert [g["geometric mean"], g["ci95 low"], g["ci95 high"], g["min"], g["max"]] == pytest.approx(
+        [1.386, 0.922, 2.084, 0.330, 5.805], abs=1e-3)
+    f = mod.variant_family_fits(mod.YFIX_DIR, "held").loc["force_normal_N_mean_steady"]
+    assert f.loc["penetration_mm", ["family estimate", "held estimate"]].to_list() == pytest.approx([-67.428, -48.325], abs=1e-3)
+    assert f.loc["spacing_mm", ["family estimate", "held estimate"]].to_list() == pytest.approx([13.275, 9.915], abs=1e-3)
+    assert f.loc["penetration_mm", "held p_value"] == pytest.approx(0.151, abs=1e-3)
+    tr = mod.variant_family_trends(mod.YFIX_DIR, "held")
+    assert tr.loc["fn_rises_with_s", "held p_value"] == pytest.approx(0.326, abs=1e-3)
+    assert tr.loc["fr_fn_rises_with_p", ["held change_1", "held p_value"]].to_list() == pytest.approx([0.523, 0.437], abs=1e-3)
+    w = mod.window_fits(pd.read_csv(mod.YFIX_WINDOWS_CSV).query("case in @names"))
+    assert w["runs"].eq(16).all()
+    assert w["F_n p N/mm"].to_list() == pytest.approx([-44.757, -57.703, -57.198, -48.325], abs=1e-3)
+    assert (w.loc[[0.1, 0.2], "F_n p p"] < 0.01).all()
+    # the disc still rides on loose grains: chips and debris carry most of its load, and fewer touch it at larger p
+    assert y[["detached share free", "detached share held"]].mean().to_list() == pytest.approx([0.960, 0.944], abs=1e-3)
+    touching = y.groupby("penetration_full_mm")["touching held"].mean()
+    assert touching.to_list() == pytest.approx([6.29, 4.45, 3.06, 3.65], abs=0.01)
+
+
 def test_recorded_linear_unrelieved_cut_keeps_the_finer_shell_gain():
     """docs/families_runs/linear_fn_vs_p/unrel_shell0p5 (session 33): session 31's unrelieved S 100 mm cut at p 7.6 mm
     (no neighbour grooves) with the finer shell, packings 12345 and 202. The gain stays (x2.57 and x1.49, as the grooved

@@ -17,11 +17,14 @@ cases with the side faces held (``linear_yfix``).
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
     python docs/families_runs/shell_held/compare.py --debris-windows docs/families_runs/shell_held/linear_debris_windows.csv \
         <parsed of the packing-12345 debris-removal runs>...
+    python docs/families_runs/shell_held/compare.py --yfix-windows docs/families_runs/shell_held/linear_yfix_windows.csv \
+        <parsed of the side-faces-held runs>...
     python docs/families_runs/shell_held/compare.py --contacts docs/families_runs/shell_held/linear_contacts.csv <X>...
     python docs/families_runs/shell_held/compare.py --pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv \
         <parsed of the 33 mm unrelieved, narrow and 20 mm runs>...
 
-(``--windows``, ``--debris-windows`` and ``--pair-windows`` overwrite their CSV with the runs passed alone.)
+(``--windows``, ``--debris-windows``, ``--yfix-windows`` and ``--pair-windows`` overwrite their CSV with the runs passed
+alone.)
 
 Prints, per kind, one row per case (recorded, held, held / recorded) and the geometric mean of held / recorded with
 its 95 % interval (``../rotary_shell0p5/compare.py``'s ``gain_row``); then, where both shells ran on the fixed deck,
@@ -59,6 +62,8 @@ WINDOWS_CSV = HERE / "linear_windows.csv"
 #: the debris-removal runs of the packing-12345 family over the same windows, keyed by their family case (``--windows``
 #: on their parsed folders writes them as ``*_debris``; ``--debris-windows`` strips the suffix)
 DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
+#: the side-faces-held runs over the same windows, keyed by their family case (``--yfix-windows``)
+YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: the grain-size pairs on narrowed unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), by block width in mm: the case-name
 #: tail of the coarse-grain runs (r 0.7-1.0 mm; the fine ones, r 0.35-0.5 mm, add ``_fine``) and the reports
 #: (``--variants``; one family case takes one variant per report, so one report per grain size). 10 mm: session 37
@@ -504,12 +509,14 @@ def debris_family_grid(packing: int = 12345, metric: str = "force_normal_N_mean_
 def yfix_effect() -> pd.DataFrame:
     """Every case of report ``linear_yfix`` (session 38: the family cases with specimen.fixed_faces zmin, xmax, ymin,
     ymax, seed 001's boundary) beside its held family run (free side faces): F_n, F_r, F_r/F_n, bonds broken, the
-    largest chip (grains, y and z extent in mm) and grains inside; held sides / free sides. Raises unless each pair
-    shares its grains and bonds."""
+    largest chip (grains, y and z extent in mm), grains inside and, from the contact census where it holds the runs,
+    the grains touching the disc and the share of its normal load that chips and debris carry; held sides / free
+    sides. Raises unless each pair shares its grains and bonds."""
     fam = _held_linear().set_index("case")
     var = pd.read_csv(YFIX_DIR / "family_table.csv").set_index("case")
     if not _same_grains_and_bonds(var, fam):
         raise ValueError(f"{YFIX_DIR}: a run does not share its grains and bonds with its held family run")
+    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
     for case, v in var.iterrows():
         f = fam.loc[case]
@@ -524,6 +531,9 @@ def yfix_effect() -> pd.DataFrame:
             for which, t in (("free", f), ("held", v)):
                 row[f"largest chip {ax} mm {which}"] = t[f"largest_chip_extent_{ax}_m"] * 1e3
         row["inside free"], row["inside held"] = f["grains_inside_cutter_final"], v["grains_inside_cutter_final"]
+        for col, short in (("grains_touching", "touching"), ("detached_share_z_1", "detached share")):
+            for which, name in (("free", case), ("held", v["variant_case"])):
+                row[f"{short} {which}"] = means.loc[name, col] if name in means.index else float("nan")
         rows.append(row)
     return pd.DataFrame(rows).set_index("case")
 
@@ -600,10 +610,11 @@ def main() -> None:
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         print(grain_pair_windows(t).round(1).to_string())
         return
-    if len(sys.argv) > 3 and sys.argv[1] in ("--windows", "--debris-windows"):
+    suffix = {"--windows": "", "--debris-windows": "_debris", "--yfix-windows": "_yfix"}
+    if len(sys.argv) > 3 and sys.argv[1] in suffix:
         t = window_table([Path(a) for a in sys.argv[3:]])
-        if sys.argv[1] == "--debris-windows":
-            t["case"] = t["case"].str.removesuffix("_debris")
+        if suffix[sys.argv[1]]:
+            t["case"] = t["case"].str.removesuffix(suffix[sys.argv[1]])
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         with pd.option_context("display.width", 250, "display.max_columns", 40):
             print(window_fits(t).round(4).T.to_string())
@@ -670,6 +681,9 @@ def main() -> None:
                 print(variant_family_grid(YFIX_DIR, "held", metric="rolling_to_normal_ratio_1").round(3).to_string())
                 print(variant_family_fits(YFIX_DIR, "held").round(4).to_string())
                 print(variant_family_trends(YFIX_DIR, "held").round(3).T.to_string())
+                if YFIX_WINDOWS_CSV.is_file():
+                    print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
+                    print(window_fits(pd.read_csv(YFIX_WINDOWS_CSV)).round(4).T.to_string())
         if any((d / "family_table.csv").is_file() for _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
             print()
             print("== grain size on narrowed unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm: report linear_unrel)")

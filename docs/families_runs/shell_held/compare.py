@@ -37,6 +37,7 @@ import importlib.util
 import json
 import sys
 from pathlib import Path
+from typing import Callable
 
 import pandas as pd
 
@@ -386,6 +387,40 @@ def contact_fits(contacts: pd.DataFrame | None = None) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _paired_variant_rows(report: Path, labels: tuple[str, str], factors: tuple[str, ...],
+                         metrics: tuple[tuple[str, str], ...], extra: Callable[[dict, pd.Series, pd.Series], None],
+                         census: tuple[tuple[str, str], ...]) -> pd.DataFrame:
+    """Every case of the variant report ``report`` beside its held family run, one row per case: the case's packing
+    seed and ``factors``, each of ``metrics`` ((column, short name)) for the two ``labels`` (family run, variant
+    run) and their ratio variant / family, what ``extra(row, family_row, variant_row)`` adds, and the contact census means of
+    ``census`` ((column, short name)) for both runs where the census holds them. Raises unless each variant run shares
+    its grains and bonds with its family run."""
+    fam = _held_linear().set_index("case")
+    var = pd.read_csv(report / "family_table.csv").set_index("case")
+    if not _same_grains_and_bonds(var, fam):
+        raise ValueError(f"{report}: a variant run does not share its grains and bonds with its held family run")
+    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
+    lf, lv = labels
+    rows = []
+    for case, v in var.iterrows():
+        f = fam.loc[case]
+        row = {"case": case, "packing_seed": int(v["packing_seed"]), **{k: v[k] for k in factors}}
+        for m, short in metrics:
+            row[f"{short} {lf}"], row[f"{short} {lv}"] = f[m], v[m]
+            row[f"{short} {lv}/{lf}"] = v[m] / f[m]
+        extra(row, f, v)
+        for col, short in census:
+            for which, name in ((lf, case), (lv, v["variant_case"])):
+                row[f"{short} {which}"] = means.loc[name, col] if name in means.index else float("nan")
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("case")
+
+
+#: the force and damage metrics both paired tables report ((family-table column, short name))
+_PAIR_METRICS = (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
+                 ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken"))
+
+
 def debris_effect() -> pd.DataFrame:
     """Every case of report ``linear_debris`` (S 100 mm at p 1.9 and 7.6 mm on packings 12345 and 202, session 36; the
     whole packing-12345 family, session 37): each held family run beside the same case with
@@ -393,26 +428,13 @@ def debris_effect() -> pd.DataFrame:
     F_r/F_n, bonds broken, grains deleted and, from the contact census where it holds the runs, the share of the disc's
     normal load that chips and debris carry and the grains touching the disc; debris run / family run. Raises unless
     each debris run shares its grains and bonds with its family run."""
-    fam = _held_linear().set_index("case")
-    deb = pd.read_csv(DEBRIS_DIR / "family_table.csv").set_index("case")
-    if not _same_grains_and_bonds(deb, fam):
-        raise ValueError(f"{DEBRIS_DIR}: a debris run does not share its grains and bonds with its held family run")
-    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
-    rows = []
-    for case, d in deb.iterrows():
-        f = fam.loc[case]
-        row = {"case": case, "packing_seed": int(d["packing_seed"]), "penetration_full_mm": d["penetration_full_mm"]}
-        for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
-                         ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken")):
-            row[f"{short} family"], row[f"{short} debris"] = f[m], d[m]
-            row[f"{short} debris/family"] = d[m] / f[m]
+    def deleted_and_inside(row: dict, f: pd.Series, d: pd.Series) -> None:
         row["grains deleted"] = d["n_grains_deleted_debris"]
         row["inside debris"] = d["grains_inside_cutter_final"]
-        for col, short in (("detached_share_z_1", "detached share"), ("grains_touching", "touching")):
-            for which, name in (("family", case), ("debris", d["variant_case"])):
-                row[f"{short} {which}"] = means.loc[name, col] if name in means.index else float("nan")
-        rows.append(row)
-    return pd.DataFrame(rows).set_index("case")
+
+    return _paired_variant_rows(DEBRIS_DIR, ("family", "debris"), ("penetration_full_mm",), _PAIR_METRICS,
+                                deleted_and_inside,
+                                (("detached_share_z_1", "detached share"), ("grains_touching", "touching")))
 
 
 def _s100_p_ratio(effect: pd.DataFrame, labels: tuple[str, str]) -> pd.DataFrame:
@@ -512,30 +534,15 @@ def yfix_effect() -> pd.DataFrame:
     largest chip (grains, y and z extent in mm), grains inside and, from the contact census where it holds the runs,
     the grains touching the disc and the share of its normal load that chips and debris carry; held sides / free
     sides. Raises unless each pair shares its grains and bonds."""
-    fam = _held_linear().set_index("case")
-    var = pd.read_csv(YFIX_DIR / "family_table.csv").set_index("case")
-    if not _same_grains_and_bonds(var, fam):
-        raise ValueError(f"{YFIX_DIR}: a run does not share its grains and bonds with its held family run")
-    means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
-    rows = []
-    for case, v in var.iterrows():
-        f = fam.loc[case]
-        row = {"case": case, "packing_seed": int(v["packing_seed"]), "spacing_full_mm": v["spacing_full_mm"],
-               "penetration_full_mm": v["penetration_full_mm"]}
-        for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
-                         ("rolling_to_normal_ratio_1", "F_r/F_n"), ("bonds_broken", "bonds broken"),
-                         ("largest_chip_grains", "largest chip")):
-            row[f"{short} free"], row[f"{short} held"] = f[m], v[m]
-            row[f"{short} held/free"] = v[m] / f[m]
+    def chips_and_inside(row: dict, f: pd.Series, v: pd.Series) -> None:
         for ax in "yz":
             for which, t in (("free", f), ("held", v)):
                 row[f"largest chip {ax} mm {which}"] = t[f"largest_chip_extent_{ax}_m"] * 1e3
         row["inside free"], row["inside held"] = f["grains_inside_cutter_final"], v["grains_inside_cutter_final"]
-        for col, short in (("grains_touching", "touching"), ("detached_share_z_1", "detached share")):
-            for which, name in (("free", case), ("held", v["variant_case"])):
-                row[f"{short} {which}"] = means.loc[name, col] if name in means.index else float("nan")
-        rows.append(row)
-    return pd.DataFrame(rows).set_index("case")
+
+    return _paired_variant_rows(YFIX_DIR, ("free", "held"), ("spacing_full_mm", "penetration_full_mm"),
+                                (*_PAIR_METRICS, ("largest_chip_grains", "largest chip")), chips_and_inside,
+                                (("grains_touching", "touching"), ("detached_share_z_1", "detached share")))
 
 
 def yfix_p_ratio() -> pd.DataFrame:

@@ -11,7 +11,8 @@ block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair 
 (``linear_h24``, new). Session 36 brought ``linear`` to 43 cases and added the contact census, the windows and the
 S 100 mm debris-removal runs (``linear_debris``); session 37 the last five cases (48) and the whole packing-12345
 family with run.debris_removal_every; session 38 the grain-size pairs by block width (``GRAIN_PAIRS``) and the family
-cases with the side faces held (``linear_yfix``).
+cases with the side faces held (``linear_yfix``); session 39 the grain-size pair on the 20 mm block with its side
+faces held (``linear_w20_yfix``, ``linear_w20_fine_yfix``).
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
@@ -67,10 +68,14 @@ DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
 YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: the grain-size pairs on narrowed unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), by block width in mm: the case-name
 #: tail of the coarse-grain runs (r 0.7-1.0 mm; the fine ones, r 0.35-0.5 mm, add ``_fine``) and the reports
-#: (``--variants``; one family case takes one variant per report, so one report per grain size). 10 mm: session 37
-#: (the fine pair stopped for time); 20 mm: session 38
-GRAIN_PAIRS = {10: ("_narrow", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
-               20: ("_w20", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"})}
+#: (``--variants``; one family case takes one variant per report, so one report per grain size), keyed by (width mm,
+#: side faces free or held). The case names are ``lin_red_s100_p{1p9,7p6}`` + tail + ``_fine`` for the fine grains +
+#: end. 10 mm: session 37 (the fine pair stopped for time); 20 mm free: session 38 (the fine pair stopped: the block
+#: splits a side off); 20 mm with the y faces held (``_yfix``): session 39, the fine runs stopped at the end of the
+#: patch window 0.2-0.4 (compare them over the windows, :func:`grain_pair_windows`, not over their case window)
+GRAIN_PAIRS = {(10, "free"): ("_narrow", "", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
+               (20, "free"): ("_w20", "", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"}),
+               (20, "held"): ("_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix", "fine": HERE / "linear_w20_fine_yfix"})}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
@@ -273,7 +278,7 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
     """F_n and F_r of each held linear run averaged over every window of :data:`PATCH_WINDOWS` (``families.middle_window``
     from the run's own block, disc, penetration and travel; ``results.steady_mask`` on its parsed series): one row per
     run and window. ``parsed`` are ``deckgen parse`` folders with the run folder beside them as ``../run``."""
-    from deckgen.families import middle_window
+    from deckgen.families import half_chord_mm, middle_window
     from deckgen.results import steady_mask
 
     rows = []
@@ -287,6 +292,11 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
         k = case["kinematics"]
         ts = pd.read_parquet(d / "timeseries.parquet", columns=["time_s", "force_normal_N", "force_rolling_N"])
         for lo in PATCH_WINDOWS:
+            # a run whose travel was cut short (session 39's fine 20 mm runs) has no row for a window it does not
+            # finish; middle_window would clip it to the travel's end and average a part of it
+            hc = half_chord_mm(1e3 * s["cutter_radius_m"], k["penetration_mm"])
+            if ((lo + 0.2) * case["specimen"]["length_mm"] + hc / 2 + k["start_clearance_mm"]) / k["travel_mm"] > 1.0 + 1e-9:
+                continue
             w = middle_window(case["specimen"]["length_mm"], 1e3 * s["cutter_radius_m"], k["penetration_mm"],
                               k["start_clearance_mm"], k["travel_mm"], lo, lo + 0.2)
             m = steady_mask(ts["time_s"], s["cut_duration_s"], w)
@@ -565,18 +575,19 @@ def grain_pairs() -> pd.DataFrame:
     width W and grain size, per p: F_n, F_r, F_r/F_n, grains, bonds broken and their fraction, grains inside, wall
     minutes, the largest chip (grains, y and z extent in mm) and, from the contact census where it holds the runs, the
     grains touching the disc and the share of its normal load that chips and debris carry; with p 7.6 / p 1.9 mm ratios;
-    only the reports that exist (session 37's 10 mm fine pair, ~65 min per run, was stopped for time). Index
-    (width_mm, grains)."""
+    only the reports that exist (session 37's 10 mm fine pair, ~65 min per run, was stopped for time). F_n and F_r
+    are over each run's own case window, which for the held 20 mm fine runs (shortened travel) is the patch window
+    0.2-0.4 of the block, not the others' 0.4-0.6. Index (width_mm, sides, grains)."""
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
-    for width, (tail, dirs) in GRAIN_PAIRS.items():
+    for (width, sides), (tail, end, dirs) in GRAIN_PAIRS.items():
         for size, suffix in (("coarse", ""), ("fine", "_fine")):
             if not (dirs[size] / "family_table.csv").is_file():
                 continue
             t = pd.read_csv(dirs[size] / "family_table.csv").set_index("variant_case")
-            row = {"width_mm": width, "grains": size}
+            row = {"width_mm": width, "sides": sides, "grains": size}
             for p in ("1p9", "7p6"):
-                name = f"lin_red_s100_p{p}{tail}{suffix}"
+                name = f"lin_red_s100_p{p}{tail}{suffix}{end}"
                 r = t.loc[name]
                 for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
                                  ("rolling_to_normal_ratio_1", "F_r/F_n"), ("n_grains", "grains"),
@@ -593,7 +604,7 @@ def grain_pairs() -> pd.DataFrame:
             row["F_n p7.6/p1.9"] = row["F_n N p7p6"] / row["F_n N p1p9"]
             row["F_r/F_n p7.6/p1.9"] = row["F_r/F_n p7p6"] / row["F_r/F_n p1p9"]
             rows.append(row)
-    return pd.DataFrame(rows).set_index(["width_mm", "grains"])
+    return pd.DataFrame(rows).set_index(["width_mm", "sides", "grains"])
 
 
 def grain_pair_windows(windows: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -691,7 +702,7 @@ def main() -> None:
                 if YFIX_WINDOWS_CSV.is_file():
                     print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                     print(window_fits(pd.read_csv(YFIX_WINDOWS_CSV)).round(4).T.to_string())
-        if any((d / "family_table.csv").is_file() for _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
+        if any((d / "family_table.csv").is_file() for _, _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
             print()
             print("== grain size on narrowed unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm: report linear_unrel)")
             print(grain_pairs().round(3).T.to_string())

@@ -1720,8 +1720,8 @@ def test_held_linear_narrow_block_breaks_up_under_the_disc():
             ("packing", "radius_min_mm"): (0.35, 0.7), ("packing", "radius_max_mm"): (0.5, 1.0)}
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     t = mod.grain_pairs()
-    assert (10, "free", "fine") not in t.index  # the fine pair was stopped for time
-    c = t.loc[(10, "free", "coarse")]
+    assert (10, "free", 12345, "fine") not in t.index  # the fine pair was stopped for time
+    c = t.loc[(10, "free", 12345, "coarse")]
     assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([22.528, 17.890, 0.794], abs=1e-3)
     assert [c["broken fraction p1p9"], c["broken fraction p7p6"]] == pytest.approx([0.382, 0.511], abs=1e-3)
     assert c["grains p1p9"] == c["grains p7p6"] == 763 and c["inside p1p9"] == c["inside p7p6"] == 0
@@ -1746,7 +1746,7 @@ def test_held_linear_20mm_block_splits_a_side_off_where_the_33mm_block_holds():
             assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_w20{g}.yaml", rec / f"lin_red_s100_p{p}_narrow{g}.yaml") == {
                 ("specimen", "width_mm"): (20, 10)}
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
-    c = mod.grain_pairs().loc[(20, "free", "coarse")]
+    c = mod.grain_pairs().loc[(20, "free", 12345, "coarse")]
     assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([33.699, 60.541, 1.797], abs=1e-3)
     assert c["grains p1p9"] == c["grains p7p6"] == 1523 and c["inside p1p9"] == c["inside p7p6"] == 0
     # a side split off: the largest chip spans half the block's width and all its height

@@ -105,9 +105,12 @@ def packing_key(case: Case) -> str:
     return hashlib.sha256(blob).hexdigest()[:16]
 
 
-def draw_radii(case: Case, volume: float, rng: np.random.Generator) -> np.ndarray:
+def draw_radii(case: Case, volume: float, rng: np.random.Generator,
+               radii_mm: tuple[float, float] | None = None) -> np.ndarray:
+    """Radii (m), uniform in [r_min, r_max] (the packing's, or ``radii_mm``), until their volume fills
+    ``solid_fraction_target`` of ``volume``."""
     p = case.packing
-    rmin, rmax = p.radius_min_mm * MM, p.radius_max_mm * MM
+    rmin, rmax = (p.radius_min_mm * MM, p.radius_max_mm * MM) if radii_mm is None else (radii_mm[0] * MM, radii_mm[1] * MM)
     mean_v = 4.0 / 3.0 * math.pi * (rmin**3 + rmin**2 * rmax + rmin * rmax**2 + rmax**3) / 4.0
     n_guess = int(p.solid_fraction_target * volume / mean_v * 1.2) + 16
     r = rng.uniform(rmin, rmax, n_guess)
@@ -118,23 +121,56 @@ def draw_radii(case: Case, volume: float, rng: np.random.Generator) -> np.ndarra
     return r[:n]
 
 
+def fine_zone_box(case: Case) -> np.ndarray | None:
+    """The band of :class:`~deckgen.spec.FineZone` as a (3, 2) box in m (x over the whole block), or None."""
+    fz = case.packing.fine_zone
+    if fz is None:
+        return None
+    b = np.asarray(specimen_region(case).bounds, dtype=float).reshape(3, 2).copy()
+    b[1] = ((fz.centre_y_mm - fz.half_width_mm) * MM, (fz.centre_y_mm + fz.half_width_mm) * MM)
+    b[2, 0] = b[2, 1] - fz.depth_mm * MM
+    return b
+
+
+def _in_box(x: np.ndarray, box: np.ndarray) -> np.ndarray:
+    return np.all((x >= box[:, 0]) & (x <= box[:, 1]), axis=1)
+
+
 def insert_grains(case: Case, max_rounds: int = 200) -> tuple[np.ndarray, np.ndarray]:
     """Random non-overlapping positions of grains at ``insertion_scale`` of their radius.
 
-    Returns (x [m], r_full [m]). Deterministic for a given seed.
+    With ``packing.fine_zone`` the band's volume is filled with the band's radii, centres drawn inside it, and the rest
+    of the block with the packing's radii, centres drawn outside it; the growth and the deflation then treat all
+    grains alike (one radius scale). Returns (x [m], r_full [m]). Deterministic for a given seed.
     """
     reg = specimen_region(case)
     rng = np.random.default_rng(case.packing.seed)
-    r = draw_radii(case, reg.volume_m3, rng)
+    fz, zone = case.packing.fine_zone, fine_zone_box(case)
+    if zone is None:
+        r = draw_radii(case, reg.volume_m3, rng)
+        fine = np.zeros(len(r), dtype=bool)
+    else:
+        v_zone = float(np.prod(zone[:, 1] - zone[:, 0]))
+        r_coarse = draw_radii(case, reg.volume_m3 - v_zone, rng)
+        r_fine = draw_radii(case, v_zone, rng, (fz.radius_min_mm, fz.radius_max_mm))
+        r = np.concatenate([r_coarse, r_fine])
+        fine = np.arange(len(r)) >= len(r_coarse)
     ri = r * case.packing.insertion_scale
     b = np.asarray(reg.bounds).reshape(3, 2)
     x = np.empty((len(r), 3))
     todo = np.arange(len(r))
     for _ in range(max_rounds):
-        # draw inside the bounding box, keep draws fully inside the region
+        # draw inside the bounding box (a fine grain inside its band), keep draws fully inside the region (and a
+        # coarse grain's centre outside the band)
         while len(todo):
-            cand = rng.uniform(b[:, 0], b[:, 1], size=(len(todo), 3))
-            ok = reg.contains(cand, ri[todo])
+            if zone is None:
+                cand = rng.uniform(b[:, 0], b[:, 1], size=(len(todo), 3))
+                ok = reg.contains(cand, ri[todo])
+            else:
+                f = fine[todo]
+                cand = np.where(f[:, None], rng.uniform(zone[:, 0], zone[:, 1], size=(len(todo), 3)),
+                                rng.uniform(b[:, 0], b[:, 1], size=(len(todo), 3)))
+                ok = reg.contains(cand, ri[todo]) & (f | ~_in_box(cand, zone))
             x[todo[ok]] = cand[ok]
             todo = todo[~ok]
         pairs = cKDTree(x).query_pairs(2 * ri.max(), output_type="ndarray")
@@ -204,11 +240,13 @@ def pack_context(case: Case) -> dict[str, Any]:
     reg = specimen_region(case)
     E = p.contact_modulus_GPa * GPA
     nu = case.contact.poisson_ratio
-    rmin = p.radius_min_mm * MM * p.insertion_scale
+    r_small = p.fine_zone.radius_min_mm if p.fine_zone is not None else p.radius_min_mm
+    rmin = r_small * MM * p.insertion_scale
     dt = contact_timestep(rmin, case.material.density_kg_m3, E, nu, safety=0.2)
     ratio = (1.0 / p.insertion_scale) ** (1.0 / p.growth_stages)
     # target pressure: Hertz contact at mean relative overlap eps (delta = eps * 2 r), Z = 6,
-    # P = phi Z f / (pi d^2) (Rothenburg-Bathurst mean stress of a packing of spheres of diameter d)
+    # P = phi Z f / (pi d^2) (Rothenburg-Bathurst mean stress of a packing of spheres of diameter d); f ~ d^2 at a
+    # given relative overlap, so P does not depend on d and a fine zone needs no other target
     r_mean = 0.5 * (p.radius_min_mm + p.radius_max_mm) * MM
     e_star = E / (2 * (1 - nu**2))
     delta = p.target_overlap * 2 * r_mean

@@ -55,6 +55,26 @@ class Material(_Model):
 
 
 # --------------------------------------------------------------------------- packing
+class FineZone(_Model):
+    """A band of finer grains along the cut of a cutting block: a local refinement where the disc crushes the rock,
+    so the grains there are small beside the cut's depth while the rest of the block keeps the coarse, cheap grains.
+    The bonds take the case's bond card at both sizes (not re-calibrated for the finer grains: compare runs with and
+    without the band, not its level against a calibrated rock). LAMMPS cutting blocks only."""
+
+    radius_min_mm: float = _f(0.35, "mm", "Smallest grain radius in the band.", gt=0)
+    radius_max_mm: float = _f(0.5, "mm", "Largest grain radius in the band.", gt=0)
+    half_width_mm: float = _f(6.0, "mm", "The band holds the grains centred within this distance of centre_y_mm.", gt=0)
+    centre_y_mm: float = _f(0.0, "mm", "y of the band's middle (the block spans y from -width/2 to +width/2; "
+                            "linear and rotary cuts run along y = 0).")
+    depth_mm: float = _f(6.0, "mm", "The band reaches this far down from the top face (z = height).", gt=0)
+
+    @model_validator(mode="after")
+    def _radii(self) -> "FineZone":
+        if self.radius_max_mm < self.radius_min_mm:
+            raise ValueError("radius_max_mm must be >= radius_min_mm (swap them)")
+        return self
+
+
 class Packing(_Model):
     """Dense polydisperse packing made by the engine: random insertion at reduced size, radius
     growth inside frictionless walls with viscous drag, relaxation (see docs/model.md, "Packing")."""
@@ -86,6 +106,11 @@ class Packing(_Model):
         "packing (one case packed on 1 and on 2 ranks gave 2388 and 2384 grains), so a case file fixes its packing. "
         "Raise it only for packings too big for one rank. A user's own engine command (--engine-cmd, DECKGEN_LMP) is "
         "used as given. Left out of spec.json and the packing key at 1.")
+    fine_zone: FineZone | None = Field(
+        None, exclude_if=lambda v: v is None,
+        description="Optional band of finer grains along the cut of a cutting block (LAMMPS): grains whose centres "
+        "lie in it are drawn from its radii, the rest from radius_min_mm-radius_max_mm. Left out of spec.json and the "
+        "packing key when absent.")
 
     @model_validator(mode="after")
     def _radii(self) -> "Packing":
@@ -520,6 +545,25 @@ class Case(_Model):
                 f"specimen: smallest dimension {dmin:g} mm is less than 4 grain radii "
                 f"({4 * p.radius_max_mm:g} mm): enlarge the specimen or use smaller grains"
             )
+        fz = p.fine_zone
+        if fz is not None:
+            if not isinstance(sp, CuttingBlock) or self.engine != "lammps":
+                raise ValueError("packing.fine_zone: a band of finer grains along a cut is made for LAMMPS cutting "
+                                 "blocks only (fix: remove packing.fine_zone, or use engine lammps with a cutting_block)")
+            if fz.radius_max_mm > p.radius_min_mm:
+                raise ValueError(f"packing.fine_zone.radius_max_mm: {fz.radius_max_mm:g} mm is more than the block's "
+                                 f"smallest grain radius {p.radius_min_mm:g} mm (fix: the band's grains must be the "
+                                 "finer ones)")
+            if fz.depth_mm > sp.height_mm:
+                raise ValueError(f"packing.fine_zone.depth_mm: {fz.depth_mm:g} mm is more than the block height "
+                                 f"{sp.height_mm:g} mm (fix: at most the height)")
+            if abs(fz.centre_y_mm) + fz.half_width_mm > sp.width_mm / 2 + 1e-9:
+                raise ValueError(f"packing.fine_zone: the band |y - {fz.centre_y_mm:g}| <= {fz.half_width_mm:g} mm "
+                                 f"leaves the block (y within +-{sp.width_mm / 2:g} mm) (fix: a smaller half_width_mm "
+                                 "or centre_y_mm)")
+            if min(fz.depth_mm, 2 * fz.half_width_mm) < 4 * fz.radius_max_mm:
+                raise ValueError(f"packing.fine_zone: the band is less than 4 of its grain radii thick "
+                                 f"({4 * fz.radius_max_mm:g} mm) (fix: a deeper or wider band, or smaller grains)")
         if isinstance(sp, CuttingBlock):
             k = self.kinematics
             if k.penetration_mm >= sp.height_mm:
@@ -570,11 +614,13 @@ class Case(_Model):
                 # exists (deck.render_case); above half the largest radius a grain can have after the bonding shrink,
                 # every packing fails that check, so say it here instead of after minutes of packing
                 shrink = 1.0 - self.bonds.shrink_before_bonding
-                r_top = p.radius_max_mm * shrink
+                # with a fine zone the packing's smallest grain is one of the band's
+                r_lo, r_hi = (fz.radius_min_mm, fz.radius_max_mm) if fz is not None else (p.radius_min_mm, p.radius_max_mm)
+                r_top = r_hi * shrink
                 if cu.shell_radius_mm > 0.5 * r_top:
                     raise ValueError(f"cutter.shell_radius_mm: {cu.shell_radius_mm:g} mm is more than half the largest grain "
                                      f"radius a packing can have ({0.5 * r_top:.3g} mm) (fix: at most half the smallest "
-                                     f"grain radius, about {0.5 * p.radius_min_mm * shrink:.3g} mm; "
+                                     f"grain radius, about {0.5 * r_lo * shrink:.3g} mm; "
                                      "the packed grains set the exact limit)")
         return self
 

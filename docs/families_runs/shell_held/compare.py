@@ -69,13 +69,16 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: the grain-size pairs on narrowed unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), by block width in mm: the case-name
 #: tail of the coarse-grain runs (r 0.7-1.0 mm; the fine ones, r 0.35-0.5 mm, add ``_fine``) and the reports
 #: (``--variants``; one family case takes one variant per report, so one report per grain size), keyed by (width mm,
-#: side faces free or held). The case names are ``lin_red_s100_p{1p9,7p6}`` + tail + ``_fine`` for the fine grains +
-#: end. 10 mm: session 37 (the fine pair stopped for time); 20 mm free: session 38 (the fine pair stopped: the block
-#: splits a side off); 20 mm with the y faces held (``_yfix``): session 39, the fine runs stopped at the end of the
-#: patch window 0.2-0.4 (compare them over the windows, :func:`grain_pair_windows`, not over their case window)
-GRAIN_PAIRS = {(10, "free"): ("_narrow", "", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
-               (20, "free"): ("_w20", "", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"}),
-               (20, "held"): ("_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix", "fine": HERE / "linear_w20_fine_yfix"})}
+#: side faces free or held, packing seed). The case names are ``lin_red_s100_p{1p9,7p6}`` + tail + ``_fine`` for the
+#: fine grains + end. 10 mm: session 37 (the fine pair stopped for time); 20 mm free: session 38 (the fine pair
+#: stopped: the block splits a side off); 20 mm with the y faces held (``_yfix``): session 39, the fine runs stopped
+#: at the end of the patch window 0.2-0.4 (compare them over the windows, :func:`pair_window_ratios`, not over their
+#: case window), and the coarse pair on packing 202 as well (no fine pair; its runs are in the same report)
+GRAIN_PAIRS = {
+    (10, "free", 12345): ("_narrow", "", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
+    (20, "free", 12345): ("_w20", "", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"}),
+    (20, "held", 12345): ("_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix", "fine": HERE / "linear_w20_fine_yfix"}),
+    (20, "held", 202): ("_k202_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix"})}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
@@ -577,15 +580,17 @@ def grain_pairs() -> pd.DataFrame:
     grains touching the disc and the share of its normal load that chips and debris carry; with p 7.6 / p 1.9 mm ratios;
     only the reports that exist (session 37's 10 mm fine pair, ~65 min per run, was stopped for time). F_n and F_r
     are over each run's own case window, which for the held 20 mm fine runs (shortened travel) is the patch window
-    0.2-0.4 of the block, not the others' 0.4-0.6. Index (width_mm, sides, grains)."""
+    0.2-0.4 of the block, not the others' 0.4-0.6. Index (width_mm, sides, packing, grains)."""
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
-    for (width, sides), (tail, end, dirs) in GRAIN_PAIRS.items():
+    for (width, sides, packing), (tail, end, dirs) in GRAIN_PAIRS.items():
         for size, suffix in (("coarse", ""), ("fine", "_fine")):
-            if not (dirs[size] / "family_table.csv").is_file():
+            if size not in dirs or not (dirs[size] / "family_table.csv").is_file():
                 continue
             t = pd.read_csv(dirs[size] / "family_table.csv").set_index("variant_case")
-            row = {"width_mm": width, "sides": sides, "grains": size}
+            if not {f"lin_red_s100_p{p}{tail}{suffix}{end}" for p in ("1p9", "7p6")} <= set(t.index):
+                continue  # a report without this pair's runs (yet)
+            row = {"width_mm": width, "sides": sides, "packing": packing, "grains": size}
             for p in ("1p9", "7p6"):
                 name = f"lin_red_s100_p{p}{tail}{suffix}{end}"
                 r = t.loc[name]
@@ -604,7 +609,7 @@ def grain_pairs() -> pd.DataFrame:
             row["F_n p7.6/p1.9"] = row["F_n N p7p6"] / row["F_n N p1p9"]
             row["F_r/F_n p7.6/p1.9"] = row["F_r/F_n p7p6"] / row["F_r/F_n p1p9"]
             rows.append(row)
-    return pd.DataFrame(rows).set_index(["width_mm", "sides", "grains"])
+    return pd.DataFrame(rows).set_index(["width_mm", "sides", "packing", "grains"])
 
 
 def grain_pair_windows(windows: pd.DataFrame | None = None) -> pd.DataFrame:
@@ -615,12 +620,28 @@ def grain_pair_windows(windows: pd.DataFrame | None = None) -> pd.DataFrame:
     return w.pivot(index="case", columns="patch_lo_1", values="force_normal_N_mean_steady")  # raises on a case twice
 
 
+def pair_window_ratios(windows: pd.DataFrame | None = None) -> pd.DataFrame:
+    """F_n at p 7.6 mm over F_n at p 1.9 mm, window by window, for every pair of :func:`grain_pair_windows` (rows: the
+    case-name tail after ``lin_red_s100_p{1p9,7p6}``, e.g. ``_w20_fine_yfix``; ``_unrel`` is the 33 mm block): the
+    change of F_n with p over the same stretch of the cut, the like-for-like comparison for runs whose case windows
+    differ (session 39's shortened fine runs). NaN where either run does not finish the window."""
+    w = grain_pair_windows(windows)
+    tails = sorted({c.removeprefix("lin_red_s100_p1p9").removeprefix("lin_red_s100_p7p6") for c in w.index})
+    rows = {t: w.loc[f"lin_red_s100_p7p6{t}"] / w.loc[f"lin_red_s100_p1p9{t}"] for t in tails
+            if f"lin_red_s100_p7p6{t}" in w.index and f"lin_red_s100_p1p9{t}" in w.index}
+    return pd.DataFrame(rows).T.rename_axis("pair")
+
+
 def main() -> None:
     if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
         t = contact_table([Path(a) for a in sys.argv[3:]])
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         with pd.option_context("display.width", 250, "display.max_columns", 40):
-            print(contact_runs(t).round(3).to_string(index=False))
+            runs = contact_runs(t)
+            if len(runs) < 4:  # the fits need family runs; a census of diagnostics alone prints their means
+                print(contact_means(t).round(3).T.to_string())
+                return
+            print(runs.round(3).to_string(index=False))
             print(contact_fits(t).round(4).to_string(index=False))
         return
     if len(sys.argv) > 3 and sys.argv[1] == "--pair-windows":
@@ -709,6 +730,8 @@ def main() -> None:
             if PAIR_WINDOWS_CSV.is_file():
                 print("-- F_n N over windows of the cut (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(grain_pair_windows().round(1).to_string())
+                print("-- F_n p 7.6 / p 1.9 mm over the same windows")
+                print(pair_window_ratios().round(3).to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

@@ -91,7 +91,13 @@ def cmd_render(args: argparse.Namespace) -> int:
 
     case = load_case(args.case)
     if args.engine and args.engine != case.engine:
-        case = case.model_copy(update={"engine": args.engine})
+        from pydantic import ValidationError
+
+        try:  # validated again: some fields are engine-specific (e.g. packing.fine_zone is LAMMPS only)
+            case = type(case).model_validate({**case.model_dump(mode="json"), "engine": args.engine})
+        except ValidationError as exc:
+            print(f"{args.case}: --engine {args.engine}: {exc.errors()[0]['msg']}", file=sys.stderr)
+            return 2
     if case.engine == "liggghts":
         from deckgen import liggghts as lg
 

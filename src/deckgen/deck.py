@@ -420,6 +420,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
 
     # ---- bonded specimen
     r_full = atoms.radius
+    fz = case.packing.fine_zone
+    # a two-size packing (packing.fine_zone): the band's grains, told from the block's by the gap between their radius
+    # ranges (both scaled by the packing's one radius scale)
+    fine = None if fz is None else (
+        r_full <= 0.5 * (fz.radius_max_mm + case.packing.radius_min_mm) * MM * float(packinfo["stats"]["radius_scale"]))
     pairs = find_bond_pairs(atoms.x, r_full, b.gap_tolerance)
     r = r_full * (1.0 - b.shrink_before_bonding)
     rho = case.material.density_kg_m3 * run.mass_scaling
@@ -457,7 +462,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
         intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor,
         bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
-        strength_factor=strength, bins_strength=b.type_bins_strength)
+        strength_factor=strength, bins_strength=b.type_bins_strength,
+        grain_class=None if fine is None else fine.astype(np.int64))
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
     # flat joint: the slit and the gapped faces are bonds of one type each, after the bond table's types
     slit_type = table.ntypes + 1 if len(slits) else None
@@ -467,7 +473,8 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             atoms.x, r, mass, np.concatenate([all_pairs, gapped]), E_b=b.youngs_modulus_GPa * GPA, stiffness_ratio=b.stiffness_ratio,
             sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
             radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
-            bins_radius=b.type_bins_radius, bins_length=b.type_bins_length), run.timestep_safety)
+            bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
+            grain_class=None if fine is None else fine.astype(np.int64)), run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
     dt_contact = contact_timestep(float(r.min()), rho, E_c, nu_c, safety=0.2)
@@ -478,8 +485,11 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         dt = run.timestep_s or dt_contact
 
     # ---- contact constants
-    r_mean = float(r.mean())
-    m_mean = float(mass.mean())
+    # with a fine band, from the block's own (coarse) grains: the band leaves the rest of the block's rolling
+    # stiffness and damping as they are without it (the band's grains take the same values)
+    block = slice(None) if fine is None else ~fine
+    r_mean = float(r[block].mean())
+    m_mean = float(mass[block].mean())
     e_star = E_c / (2 * (1 - nu_c**2))
     k_n_char = 2.0 * e_star * math.sqrt(0.5 * r_mean * 0.005 * r_mean)  # Hertz stiffness at 0.5 % overlap
     k_roll = k_n_char

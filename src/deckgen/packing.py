@@ -2,7 +2,8 @@
 
 Algorithm (documented in docs/model.md, "Packing"):
 1. Radii are drawn uniformly in [r_min, r_max] (seeded) until the grain volume reaches
-   ``solid_fraction_target`` x specimen volume.
+   ``solid_fraction_target`` x specimen volume (with ``packing.fine_zone``: the band's radii fill the band's
+   volume and the packing's radii the rest, each to that fraction).
 2. Grains are placed at random inside the specimen at ``insertion_scale`` of their size; overlapping
    draws are re-drawn until none overlap (random sequential addition, seeded).
 3. LAMMPS grows the radii back to full size in ``growth_stages`` separate runs (``fix adapt``,
@@ -159,10 +160,15 @@ def insert_grains(case: Case, max_rounds: int = 200) -> tuple[np.ndarray, np.nda
     b = np.asarray(reg.bounds).reshape(3, 2)
     x = np.empty((len(r), 3))
     todo = np.arange(len(r))
+    draws = 0
     for _ in range(max_rounds):
         # draw inside the bounding box (a fine grain inside its band), keep draws fully inside the region (and a
         # coarse grain's centre outside the band)
         while len(todo):
+            draws += 1
+            if draws > 100_000:  # the case checks leave room for every grain; this guards against a hang
+                raise RuntimeError(f"packing: {len(todo)} grains found no place inside the specimen (or their part of "
+                                   "it) in 100000 draws; enlarge the specimen or its part, or use smaller grains")
             if zone is None:
                 cand = rng.uniform(b[:, 0], b[:, 1], size=(len(todo), 3))
                 ok = reg.contains(cand, ri[todo])

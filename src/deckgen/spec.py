@@ -58,14 +58,17 @@ class Material(_Model):
 class FineZone(_Model):
     """A band of finer grains along the cut of a cutting block: a local refinement where the disc crushes the rock,
     so the grains there are small beside the cut's depth while the rest of the block keeps the coarse, cheap grains.
-    The bonds take the case's bond card at both sizes (not re-calibrated for the finer grains: compare runs with and
-    without the band, not its level against a calibrated rock). LAMMPS cutting blocks only."""
+    Fine grains are inserted with their centres in the band, coarse ones outside it; growing the radii mixes the
+    band's edge over about a coarse grain (docs/model.md, "Packing"). The bonds take the case's bond card at both sizes
+    (not re-calibrated for the finer grains: compare runs with and without the band, not its level against a
+    calibrated rock). LAMMPS linear cuts of a cutting block only."""
 
     radius_min_mm: float = _f(0.35, "mm", "Smallest grain radius in the band.", gt=0)
     radius_max_mm: float = _f(0.5, "mm", "Largest grain radius in the band.", gt=0)
-    half_width_mm: float = _f(6.0, "mm", "The band holds the grains centred within this distance of centre_y_mm.", gt=0)
-    centre_y_mm: float = _f(0.0, "mm", "y of the band's middle (the block spans y from -width/2 to +width/2; "
-                            "linear and rotary cuts run along y = 0).")
+    half_width_mm: float = _f(6.0, "mm", "Half the band's width: fine grains are inserted with their centres within "
+                              "this distance of centre_y_mm.", gt=0)
+    centre_y_mm: float = _f(0.0, "mm", "y of the band's middle (the block spans y from -width/2 to +width/2; a linear "
+                            "cut runs along y = 0, which the band must hold).")
     depth_mm: float = _f(6.0, "mm", "The band reaches this far down from the top face (z = height).", gt=0)
 
     @model_validator(mode="after")
@@ -108,9 +111,9 @@ class Packing(_Model):
         "used as given. Left out of spec.json and the packing key at 1.")
     fine_zone: FineZone | None = Field(
         None, exclude_if=lambda v: v is None,
-        description="Optional band of finer grains along the cut of a cutting block (LAMMPS): grains whose centres "
-        "lie in it are drawn from its radii, the rest from radius_min_mm-radius_max_mm. Left out of spec.json and the "
-        "packing key when absent.")
+        description="Optional band of finer grains along a linear cut of a cutting block (LAMMPS): its volume is "
+        "filled with grains of its radii inserted inside it, the rest of the block with radius_min_mm-radius_max_mm. "
+        "Left out of spec.json and the packing key when absent.")
 
     @model_validator(mode="after")
     def _radii(self) -> "Packing":
@@ -547,23 +550,45 @@ class Case(_Model):
             )
         fz = p.fine_zone
         if fz is not None:
-            if not isinstance(sp, CuttingBlock) or self.engine != "lammps":
-                raise ValueError("packing.fine_zone: a band of finer grains along a cut is made for LAMMPS cutting "
-                                 "blocks only (fix: remove packing.fine_zone, or use engine lammps with a cutting_block)")
-            if fz.radius_max_mm > p.radius_min_mm:
-                raise ValueError(f"packing.fine_zone.radius_max_mm: {fz.radius_max_mm:g} mm is more than the block's "
+            if not isinstance(sp, CuttingBlock) or self.engine != "lammps" or self.kinematics.mode != "linear":
+                raise ValueError("packing.fine_zone: a band of finer grains along the cut is made for LAMMPS linear "
+                                 "cuts of a cutting block only (its band runs along x) (fix: remove packing.fine_zone, "
+                                 "or use engine lammps, a cutting_block and kinematics.mode linear)")
+            if fz.radius_max_mm >= p.radius_min_mm:
+                raise ValueError(f"packing.fine_zone.radius_max_mm: {fz.radius_max_mm:g} mm is not below the block's "
                                  f"smallest grain radius {p.radius_min_mm:g} mm (fix: the band's grains must be the "
-                                 "finer ones)")
-            if fz.depth_mm > sp.height_mm:
-                raise ValueError(f"packing.fine_zone.depth_mm: {fz.depth_mm:g} mm is more than the block height "
-                                 f"{sp.height_mm:g} mm (fix: at most the height)")
-            if abs(fz.centre_y_mm) + fz.half_width_mm > sp.width_mm / 2 + 1e-9:
-                raise ValueError(f"packing.fine_zone: the band |y - {fz.centre_y_mm:g}| <= {fz.half_width_mm:g} mm "
-                                 f"leaves the block (y within +-{sp.width_mm / 2:g} mm) (fix: a smaller half_width_mm "
-                                 "or centre_y_mm)")
-            if min(fz.depth_mm, 2 * fz.half_width_mm) < 4 * fz.radius_max_mm:
-                raise ValueError(f"packing.fine_zone: the band is less than 4 of its grain radii thick "
-                                 f"({4 * fz.radius_max_mm:g} mm) (fix: a deeper or wider band, or smaller grains)")
+                                 "finer ones, with a gap between the two radius ranges)")
+            if fz.radius_min_mm < 0.2 * p.radius_min_mm:
+                raise ValueError(f"packing.fine_zone.radius_min_mm: {fz.radius_min_mm:g} mm is less than a fifth of the "
+                                 f"block's smallest grain radius {p.radius_min_mm:g} mm: the band would hold more than "
+                                 "~125x the grains of the same volume of the block (fix: larger band grains, or smaller "
+                                 "grains everywhere without a band)")
+            if not abs(fz.centre_y_mm) < fz.half_width_mm:
+                raise ValueError(f"packing.fine_zone: the band |y - {fz.centre_y_mm:g}| <= {fz.half_width_mm:g} mm misses "
+                                 "the cut, which runs along y = 0 (fix: centre_y_mm nearer 0 or a wider band)")
+            if fz.depth_mm <= self.kinematics.penetration_mm:
+                raise ValueError(f"packing.fine_zone.depth_mm: {fz.depth_mm:g} mm does not reach below the cut "
+                                 f"(kinematics.penetration_mm {self.kinematics.penetration_mm:g} mm) (fix: a deeper band)")
+            for what, size in (("depth_mm", fz.depth_mm), ("2 x half_width_mm", 2 * fz.half_width_mm)):
+                if size < 4 * fz.radius_max_mm:
+                    raise ValueError(f"packing.fine_zone.{what.split()[-1]}: the band is {size:g} mm thick across its "
+                                     f"{what}, less than 4 of its largest grain radii ({4 * fz.radius_max_mm:g} mm) "
+                                     "(fix: a deeper or wider band, or smaller band grains)")
+            # the coarse grains left beside and below the band need room: none at all, or at least 4 of their radii
+            rests = (("below it (height_mm - depth_mm)", sp.height_mm - fz.depth_mm),
+                     ("on its y min side", sp.width_mm / 2 + fz.centre_y_mm - fz.half_width_mm),
+                     ("on its y max side", sp.width_mm / 2 - fz.centre_y_mm - fz.half_width_mm))
+            for where, rest in rests:
+                if rest < -1e-9:
+                    raise ValueError(f"packing.fine_zone: the band leaves the block {where} by {-rest:g} mm (fix: a "
+                                     "smaller depth_mm or half_width_mm, or centre_y_mm nearer 0)")
+                if 1e-9 < rest < 4 * p.radius_max_mm:
+                    raise ValueError(f"packing.fine_zone: the band leaves a strip of {rest:g} mm of the block's grains "
+                                     f"{where}, less than 4 of their largest radii ({4 * p.radius_max_mm:g} mm) (fix: "
+                                     "take the strip into the band or leave at least that much)")
+            if all(rest <= 1e-9 for _, rest in rests):
+                raise ValueError("packing.fine_zone: the band fills the whole block (fix: remove fine_zone and give "
+                                 "packing.radius_min_mm/radius_max_mm the band's radii)")
         if isinstance(sp, CuttingBlock):
             k = self.kinematics
             if k.penetration_mm >= sp.height_mm:

@@ -638,11 +638,14 @@ def main() -> None:
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         with pd.option_context("display.width", 250, "display.max_columns", 40):
             runs = contact_runs(t)
-            if len(runs) < 4:  # the fits need family runs; a census of diagnostics alone prints their means
-                print(contact_means(t).round(3).T.to_string())
-                return
-            print(runs.round(3).to_string(index=False))
-            print(contact_fits(t).round(4).to_string(index=False))
+            if len(runs):
+                print(runs.round(3).to_string(index=False))
+            if len(runs) >= 4:  # the fits need family runs (three terms)
+                print(contact_fits(t).round(4).to_string(index=False))
+            means = contact_means(t)
+            other = means[~means.index.isin(runs["case"])]
+            if len(other):  # diagnostics (variants of family cases) are not fitted: their means
+                print(other.round(3).T.to_string())
         return
     if len(sys.argv) > 3 and sys.argv[1] == "--pair-windows":
         t = window_table([Path(a) for a in sys.argv[3:]])

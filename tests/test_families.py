@@ -1865,3 +1865,40 @@ def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     assert fn[707, 1000] / fn[707, 250] - 1 == pytest.approx(0.461, abs=1e-3)
     trend = pd.read_csv(rec / "report" / "trends.csv").set_index("trend")
     assert trend.loc["fn_rises_with_r", ["change_1", "p_value"]].to_list() == pytest.approx([0.811, 0.058], abs=1e-3)
+
+
+def test_held_20mm_block_with_grains_half_the_size_still_loses_force_with_p():
+    """docs/families_runs/shell_held/linear_w20_yfix and linear_w20_fine_yfix (session 39): the 20 mm grain-size pair
+    with its y faces held. Held, the block no longer splits (largest chip 3-11 grains; free 122 and 70). Over the
+    windows 0.1 and 0.2, which every run finishes (the fine runs' travel ends at patch 0.4), F_n at p 7.6 mm is 0.79
+    and 0.83 of that at p 1.9 mm with grains r 0.35-0.5 mm (12 099 grains), against 0.71 / 0.82 (packing 12345) and
+    1.97 / 0.35 (202) with r 0.7-1.0 mm: no rise with p in either window (seed x1.76), and the disc still rides on
+    loose grains (detached share 0.975 / 1.0, 12-14 grains touching)."""
+    import yaml
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p, travel, window in (("1p9", (14.5, 19.5), [0.62, 0.98]), ("7p6", (18, 23), [0.69, 0.98])):
+        held = {("specimen", "fixed_faces"): (["zmin", "xmax", "ymin", "ymax"], ["zmin", "xmax"])}
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_w20_yfix.yaml", rec / f"lin_red_s100_p{p}_w20.yaml") == held
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_w20_fine_yfix.yaml", rec / f"lin_red_s100_p{p}_w20_fine.yaml") == {
+            **held, ("kinematics", "travel_mm"): travel, ("outputs", "steady_window"): (window, yaml.safe_load(
+                (rec / f"lin_red_s100_p{p}_w20_fine.yaml").read_text())["outputs"]["steady_window"])}
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k202_w20_yfix.yaml", rec / f"lin_red_s100_p{p}_w20_yfix.yaml") == {
+            ("packing", "seed"): (202, None)}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    t = mod.grain_pairs()
+    c, f = t.loc[(20, "held", 12345, "coarse")], t.loc[(20, "held", 12345, "fine")]
+    assert c["grains p1p9"] == 1523 and f["grains p1p9"] == f["grains p7p6"] == 12099
+    assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([406.332, 164.585, 0.405], abs=1e-3)
+    assert max(c["largest chip grains p1p9"], c["largest chip grains p7p6"], f["largest chip grains p1p9"],
+               f["largest chip grains p7p6"]) < 20  # no side splits off
+    k = t.loc[(20, "held", 202, "coarse")]
+    assert [k["F_n N p1p9"], k["F_n N p7p6"]] == pytest.approx([190.307, 144.512], abs=1e-3)
+    r = mod.pair_window_ratios()
+    assert r.loc["_w20_fine_yfix", [0.1, 0.2]].tolist() == pytest.approx([0.793, 0.827], abs=1e-3)
+    assert r.loc["_w20_yfix", [0.1, 0.2]].tolist() == pytest.approx([0.709, 0.823], abs=1e-3)
+    assert r.loc["_k202_w20_yfix", [0.1, 0.2]].tolist() == pytest.approx([1.973, 0.351], abs=1e-3)
+    assert r.loc["_w20_fine_yfix", [0.3, 0.4]].isna().all()  # the shortened fine runs do not finish these windows
+    assert (r.loc["_w20_fine_yfix", [0.1, 0.2]] < 1).all()
+    assert [f["detached share p1p9"], f["detached share p7p6"]] == pytest.approx([0.975, 1.0], abs=1e-3)
+    assert [f["touching p1p9"], f["touching p7p6"]] == pytest.approx([12.167, 13.5], abs=1e-3)

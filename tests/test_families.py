@@ -1867,13 +1867,14 @@ def test_recorded_rotary_block40_diagnostic_keeps_the_normal_force_rise():
     assert trend.loc["fn_rises_with_r", ["change_1", "p_value"]].to_list() == pytest.approx([0.811, 0.058], abs=1e-3)
 
 
-def test_held_20mm_block_with_grains_half_the_size_still_loses_force_with_p():
+def test_held_20mm_block_with_grains_half_the_size_shows_no_rise_of_force_with_p_early_in_the_cut():
     """docs/families_runs/shell_held/linear_w20_yfix and linear_w20_fine_yfix (session 39): the 20 mm grain-size pair
-    with its y faces held. Held, the block no longer splits (largest chip 3-11 grains; free 122 and 70). Over the
-    windows 0.1 and 0.2, which every run finishes (the fine runs' travel ends at patch 0.4), F_n at p 7.6 mm is 0.79
-    and 0.83 of that at p 1.9 mm with grains r 0.35-0.5 mm (12 099 grains), against 0.71 / 0.82 (packing 12345) and
-    1.97 / 0.35 (202) with r 0.7-1.0 mm: no rise with p in either window (seed x1.76), and the disc still rides on
-    loose grains (detached share 0.975 / 1.0, 12-14 grains touching)."""
+    with its y faces held. Held, the block no longer splits (largest chip 3-19 grains; free 122 and 70). Over the
+    windows 0.1 and 0.2 (the first 0.1-0.4 of the block, which every run finishes; the fine runs' travel ends at
+    patch 0.4), F_n at p 7.6 mm is 0.79 and 0.83 of that at p 1.9 mm with grains r 0.35-0.5 mm (12 099 grains, one
+    pair), against 0.71 / 0.82 (packing 12345) and 1.97 / 0.35 (202) with r 0.7-1.0 mm; F_r/F_n rises x1.20 / x1.11
+    with p on the fine pair, x2.7-4.1 on the coarse ones; the disc still rides on loose grains (detached share
+    0.975 / 1.0, 12-14 grains touching)."""
     import yaml
 
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
@@ -1902,3 +1903,12 @@ def test_held_20mm_block_with_grains_half_the_size_still_loses_force_with_p():
     assert (r.loc["_w20_fine_yfix", [0.1, 0.2]] < 1).all()
     assert [f["detached share p1p9"], f["detached share p7p6"]] == pytest.approx([0.975, 1.0], abs=1e-3)
     assert [f["touching p1p9"], f["touching p7p6"]] == pytest.approx([12.167, 13.5], abs=1e-3)
+    import pandas as pd
+
+    w = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "linear_grain_pair_windows.csv")
+    w = w.assign(ratio=w["force_rolling_N_mean_steady"] / w["force_normal_N_mean_steady"]).pivot(
+        index="case", columns="patch_lo_1", values="ratio")
+    rise = {t: (w.loc[f"lin_red_s100_p7p6{t}", [0.1, 0.2]] / w.loc[f"lin_red_s100_p1p9{t}", [0.1, 0.2]]).tolist()
+            for t in ("_w20_fine_yfix", "_w20_yfix", "_k202_w20_yfix")}
+    assert rise["_w20_fine_yfix"] == pytest.approx([1.20, 1.11], abs=0.01)
+    assert min(rise["_w20_yfix"] + rise["_k202_w20_yfix"]) > 2.5  # F_r/F_n rises far more with p on coarse grains

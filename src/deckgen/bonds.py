@@ -347,22 +347,22 @@ def make_bond_table(
     inertia = 0.4 * mass * r**2
     m_eff = mass[i] * mass[j] / (mass[i] + mass[j])
     I_eff = inertia[i] * inertia[j] / (inertia[i] + inertia[j])
+    # pair class of each bond: 0 coarse-coarse, 1 mixed, 2 fine-fine (all 0 without grain_class)
+    gc = np.zeros(len(r), dtype=np.int64) if grain_class is None else np.asarray(grain_class, dtype=np.int64)
+    pair_class = gc[i] + gc[j]
+    span = max(int(bins_radius), 1) * max(int(bins_length), 1)
     types = np.zeros(len(pairs), dtype=np.int64)
     parts = []
     offset = 0
     for sel, e_f, s_f, nb_s in ((~mask, 1.0, 1.0, nbs), (mask, clump_stiffness_factor, clump_strength_factor, 1)):
         if not sel.any():
             continue
-        if grain_class is None:
-            key = _bins(rb[sel], bins_radius) * max(bins_length, 1) + _bins(L[sel], bins_length)
-        else:  # 0 coarse-coarse, 1 mixed, 2 fine-fine: each pair class gets its own quantile bins
-            pc = (np.asarray(grain_class, dtype=np.int64)[i] + np.asarray(grain_class, dtype=np.int64)[j])[sel]
-            span = max(int(bins_radius), 1) * max(int(bins_length), 1)
-            rb_s, L_s = rb[sel], L[sel]
-            key = np.empty(len(pc), dtype=np.int64)
-            for c in np.unique(pc):
-                m = pc == c
-                key[m] = c * span + _bins(rb_s[m], bins_radius) * max(bins_length, 1) + _bins(L_s[m], bins_length)
+        # quantile bins within each pair class (one class, 0, without grain_class)
+        pc, rb_s, L_s = pair_class[sel], rb[sel], L[sel]
+        key = np.empty(len(pc), dtype=np.int64)
+        for c in np.unique(pc):
+            m = pc == c
+            key[m] = c * span + _bins(rb_s[m], bins_radius) * max(bins_length, 1) + _bins(L_s[m], bins_length)
         if nb_s > 1:
             key = key * nb_s + _bins(sf[sel], nb_s)
         uniq, types0 = np.unique(key, return_inverse=True)

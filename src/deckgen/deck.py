@@ -425,6 +425,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
     # ranges (both scaled by the packing's one radius scale)
     fine = None if fz is None else (
         r_full <= 0.5 * (fz.radius_max_mm + case.packing.radius_min_mm) * MM * float(packinfo["stats"]["radius_scale"]))
+    grain_class = None if fine is None else fine.astype(np.int64)
     pairs = find_bond_pairs(atoms.x, r_full, b.gap_tolerance)
     r = r_full * (1.0 - b.shrink_before_bonding)
     rho = case.material.density_kg_m3 * run.mass_scaling
@@ -463,7 +464,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
         intra=intra, clump_strength_factor=b.clump_strength_factor, clump_stiffness_factor=b.clump_stiffness_factor,
         bending_factor=b.bending_strength_factor, twisting_factor=b.twisting_strength_factor,
         strength_factor=strength, bins_strength=b.type_bins_strength,
-        grain_class=None if fine is None else fine.astype(np.int64))
+        grain_class=grain_class)
     dt_info = stable_timestep(atoms.x, r, mass, table, run.timestep_safety)
     # flat joint: the slit and the gapped faces are bonds of one type each, after the bond table's types
     slit_type = table.ntypes + 1 if len(slits) else None
@@ -474,7 +475,7 @@ def render_case(case: Case, out: str | Path, *, cache: Path | None = None, progr
             sigma_c=b.tensile_strength_MPa * MPA, tau_c=b.shear_strength_MPa * MPA,
             radius_multiplier=b.radius_multiplier, damping_ratio=b.damping_ratio,
             bins_radius=b.type_bins_radius, bins_length=b.type_bins_length,
-            grain_class=None if fine is None else fine.astype(np.int64)), run.timestep_safety)
+            grain_class=grain_class), run.timestep_safety)
     E_c, nu_c = c.youngs_modulus_GPa * GPA, c.poisson_ratio
     E_s, nu_s = c.cutter_youngs_modulus_GPa * GPA, c.cutter_poisson_ratio
     dt_contact = contact_timestep(float(r.min()), rho, E_c, nu_c, safety=0.2)

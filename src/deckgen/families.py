@@ -178,6 +178,14 @@ def half_chord_mm(radius_mm: float, penetration_mm: float) -> float:
     return math.sqrt(radius_mm**2 - (radius_mm - penetration_mm) ** 2)
 
 
+def patch_travel_fraction(length_mm: float, radius_mm: float, penetration_mm: float, clearance_mm: float,
+                          travel_mm: float, x_frac: float) -> float:
+    """Fraction of the travel at which the centre of the contact patch reaches ``x_frac`` of the block length (the
+    disc centre x = s - half chord - clearance; the patch centre is half a half-chord ahead of it). Unclipped: above
+    1 the travel ends before the patch gets there."""
+    return (x_frac * length_mm + half_chord_mm(radius_mm, penetration_mm) / 2 + clearance_mm) / travel_mm
+
+
 def middle_window(length_mm: float, radius_mm: float, penetration_mm: float, clearance_mm: float,
                   travel_mm: float, lo: float = 0.4, hi: float = 0.6) -> list[float]:
     """Steady window (fractions of the travel) in which the centre of the contact patch lies between
@@ -185,12 +193,7 @@ def middle_window(length_mm: float, radius_mm: float, penetration_mm: float, cle
     in the middle of the 304 mm rock. The contact patch of a disc moving along +x spans from below the
     centre to a half chord ahead of it, so its centre is ~half a half-chord ahead of the disc centre.
     Clipped to the travel (the deck stops the disc before it leaves the block)."""
-    hc = half_chord_mm(radius_mm, penetration_mm)
-
-    def frac(xf: float) -> float:  # disc centre x = s - hc - clearance; contact-patch centre = that + hc/2
-        return (xf * length_mm + hc / 2 + clearance_mm) / travel_mm
-
-    a, b = frac(lo), frac(hi)
+    a, b = (patch_travel_fraction(length_mm, radius_mm, penetration_mm, clearance_mm, travel_mm, xf) for xf in (lo, hi))
     a = min(max(a, 0.0), 0.8)
     b = min(max(b, a + 0.1), 1.0)
     return [_r(a, 2), _r(b, 2)]

@@ -281,7 +281,7 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
     """F_n and F_r of each held linear run averaged over every window of :data:`PATCH_WINDOWS` (``families.middle_window``
     from the run's own block, disc, penetration and travel; ``results.steady_mask`` on its parsed series): one row per
     run and window. ``parsed`` are ``deckgen parse`` folders with the run folder beside them as ``../run``."""
-    from deckgen.families import half_chord_mm, middle_window
+    from deckgen.families import middle_window, patch_travel_fraction
     from deckgen.results import steady_mask
 
     rows = []
@@ -297,11 +297,11 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
         for lo in PATCH_WINDOWS:
             # a run whose travel was cut short (session 39's fine 20 mm runs) has no row for a window it does not
             # finish; middle_window would clip it to the travel's end and average a part of it
-            hc = half_chord_mm(1e3 * s["cutter_radius_m"], k["penetration_mm"])
-            if ((lo + 0.2) * case["specimen"]["length_mm"] + hc / 2 + k["start_clearance_mm"]) / k["travel_mm"] > 1.0 + 1e-9:
+            geometry = (case["specimen"]["length_mm"], 1e3 * s["cutter_radius_m"], k["penetration_mm"],
+                        k["start_clearance_mm"], k["travel_mm"])
+            if patch_travel_fraction(*geometry, lo + 0.2) > 1.0 + 1e-9:
                 continue
-            w = middle_window(case["specimen"]["length_mm"], 1e3 * s["cutter_radius_m"], k["penetration_mm"],
-                              k["start_clearance_mm"], k["travel_mm"], lo, lo + 0.2)
+            w = middle_window(*geometry, lo, lo + 0.2)
             m = steady_mask(ts["time_s"], s["cut_duration_s"], w)
             rows.append({"case": s["case"], "patch_lo_1": lo, "window_start_1": w[0], "window_end_1": w[1],
                          "rows": int(m.sum()), "force_normal_N_mean_steady": ts.loc[m, "force_normal_N"].mean(),

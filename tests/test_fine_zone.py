@@ -112,6 +112,19 @@ def test_the_packing_time_step_follows_the_band():
     assert dt(_tiny()) == pytest.approx(0.5 * dt(load_case(TINY_CUT, LINEAR)), rel=1e-9)  # r_min 0.3 against 0.6 mm
 
 
+def test_the_case_estimate_counts_the_band_grains_and_takes_its_time_step():
+    """families.estimate (index.csv, the family sizing) on the 33 mm band case against its one render (session 39:
+    5681 grains, dt 1.78e-8 s, 645 800 steps) and its coarse reference without the band (2488 grains rendered)."""
+    from deckgen.families import estimate
+
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    band = estimate(load_case(rec / "lin_red_s100_p7p6_unrel_band.yaml").model_dump())
+    coarse = estimate(load_case(rec / "lin_red_s100_p7p6_unrel_s016.yaml").model_dump())
+    assert band["n_grains_est"] == pytest.approx(5681, rel=0.1) and coarse["n_grains_est"] == pytest.approx(2488, rel=0.1)
+    assert band["dt_est_s"] == pytest.approx(1.78e-8, rel=0.15) and band["dt_est_s"] == pytest.approx(0.5 * coarse["dt_est_s"], rel=0.01)
+    assert band["steps_est"] == pytest.approx(645_800, rel=0.15)
+
+
 @pytest.mark.engine
 def test_the_engine_packs_a_block_with_its_band_fine_and_in_place(tmp_path):
     """The band after packing and the deck made from it: bond types binned per size class, the rolling constants of

@@ -223,10 +223,22 @@ def estimate(data: dict[str, Any]) -> dict[str, Any]:
     """Rough grain count and time steps of a cutting case (before packing); see the module doc."""
     pk, sp, bd, kin = data["packing"], data["specimen"], data["bonds"], data["kinematics"]
     rho = data["material"]["density_kg_m3"]
+
+    def mean_r3(a: float, b: float) -> float:  # <r^3> of radii uniform in [a, b]
+        return (b**4 - a**4) / (4 * (b - a)) if b > a else a**3
+
     a, b = pk["radius_min_mm"], pk["radius_max_mm"]
-    mean_r3 = (b**4 - a**4) / (4 * (b - a)) if b > a else a**3
     vol = sp["length_mm"] * sp["width_mm"] * sp["height_mm"]
-    n = SOLID_FRACTION_EST * vol / (4 / 3 * math.pi * mean_r3)
+    fz = pk.get("fine_zone")
+    band = 0.0
+    if fz:  # packing.fine_zone: its volume (clipped to the block) is filled with its own radii, each part to the target
+        w = sp["width_mm"] / 2
+        y = min(fz["centre_y_mm"] + fz["half_width_mm"], w) - max(fz["centre_y_mm"] - fz["half_width_mm"], -w)
+        band = sp["length_mm"] * max(y, 0.0) * min(fz["depth_mm"], sp["height_mm"])
+    n = SOLID_FRACTION_EST * (vol - band) / (4 / 3 * math.pi * mean_r3(a, b))
+    if fz:
+        n += SOLID_FRACTION_EST * band / (4 / 3 * math.pi * mean_r3(fz["radius_min_mm"], fz["radius_max_mm"]))
+        a = min(a, fz["radius_min_mm"])  # the band's smallest grain sets the time step
     # bond stiffness ~ E_b * (lambda r)^2: dt ~ 1/lambda (the radius multiplier; seed 000 uses 1.2)
     dt = (DT_REF_S * (a / 0.7) * math.sqrt(10.0 / bd["youngs_modulus_GPa"]) * math.sqrt(rho / 2650.0)
           / bd.get("radius_multiplier", 1.0))

@@ -66,19 +66,24 @@ WINDOWS_CSV = HERE / "linear_windows.csv"
 DEBRIS_WINDOWS_CSV = HERE / "linear_debris_windows.csv"
 #: the side-faces-held runs over the same windows, keyed by their family case (``--yfix-windows``)
 YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
-#: the grain-size pairs on narrowed unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), by block width in mm: the case-name
-#: tail of the coarse-grain runs (r 0.7-1.0 mm; the fine ones, r 0.35-0.5 mm, add ``_fine``) and the reports
-#: (``--variants``; one family case takes one variant per report, so one report per grain size), keyed by (width mm,
-#: side faces free or held, packing seed). The case names are ``lin_red_s100_p{1p9,7p6}`` + tail + ``_fine`` for the
-#: fine grains + end. 10 mm: session 37 (the fine pair stopped for time); 20 mm free: session 38 (the fine pair
-#: stopped: the block splits a side off); 20 mm with the y faces held (``_yfix``): session 39, the fine runs stopped
-#: at the end of the patch window 0.2-0.4 (compare them over the windows, :func:`pair_window_ratios`, not over their
-#: case window), and the coarse pair on packing 202 as well (no fine pair; its runs are in the same report)
+#: the grain-size pairs on unrelieved blocks (S 100 mm, p 1.9 and 7.6 mm), keyed by (block width mm, side faces free or
+#: held, packing seed): per grain size (``coarse`` r 0.7-1.0 mm; ``fine`` r 0.35-0.5 mm throughout; ``band`` r 0.35-0.5
+#: mm in packing.fine_zone along the cut, coarse elsewhere) the case-name tail after ``lin_red_s100_p{1p9,7p6}`` and the
+#: report (``--variants``; one family case takes one variant per report, so one report per grain size). 10 mm: session
+#: 37 (the fine pair stopped for time); 20 mm free: session 38 (the fine pair stopped: the block splits a side off); 20 mm
+#: with the y faces held (``_yfix``): session 39, the fine runs stopped at the end of the patch window 0.2-0.4 (compare
+#: them over the windows, :func:`pair_window_ratios`, not over their case window), and the coarse pair on packing 202
+#: as well (no fine pair; its runs are in the same report); 33 mm free: session 40, the band pair and its coarse
+#: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell)
 GRAIN_PAIRS = {
-    (10, "free", 12345): ("_narrow", "", {"coarse": HERE / "linear_narrow", "fine": HERE / "linear_narrow_fine"}),
-    (20, "free", 12345): ("_w20", "", {"coarse": HERE / "linear_w20", "fine": HERE / "linear_w20_fine"}),
-    (20, "held", 12345): ("_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix", "fine": HERE / "linear_w20_fine_yfix"}),
-    (20, "held", 202): ("_k202_w20", "_yfix", {"coarse": HERE / "linear_w20_yfix"})}
+    (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
+                          "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
+    (20, "free", 12345): {"coarse": ("_w20", HERE / "linear_w20"), "fine": ("_w20_fine", HERE / "linear_w20_fine")},
+    (20, "held", 12345): {"coarse": ("_w20_yfix", HERE / "linear_w20_yfix"),
+                          "fine": ("_w20_fine_yfix", HERE / "linear_w20_fine_yfix")},
+    (20, "held", 202): {"coarse": ("_k202_w20_yfix", HERE / "linear_w20_yfix")},
+    (33, "free", 12345): {"coarse": ("_unrel_s016", HERE / "linear_unrel_s016"),
+                          "band": ("_unrel_band", HERE / "linear_unrel_band")}}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
@@ -574,7 +579,8 @@ def idle_dumps(cases: list[str], from_fraction: float = 0.5) -> pd.DataFrame:
 
 def grain_pairs() -> pd.DataFrame:
     """The grain-size pairs of :data:`GRAIN_PAIRS`: session 31's unrelieved S 100 mm cut at p 1.9 and 7.6 mm on blocks
-    26 x W x 12 mm with coarse (r 0.7-1.0 mm) and fine (r 0.35-0.5 mm) grains, both with the r 0.16 mm shell. Per block
+    26 x W x 12 mm with coarse (r 0.7-1.0 mm) and fine (r 0.35-0.5 mm) grains, or (33 mm) a band of fine grains along the
+    cut, all with the r 0.16 mm shell. Per block
     width W and grain size, per p: F_n, F_r, F_r/F_n, grains, bonds broken and their fraction, grains inside, wall
     minutes, the largest chip (grains, y and z extent in mm) and, from the contact census where it holds the runs, the
     grains touching the disc and the share of its normal load that chips and debris carry; with p 7.6 / p 1.9 mm ratios;
@@ -583,16 +589,16 @@ def grain_pairs() -> pd.DataFrame:
     0.2-0.4 of the block, not the others' 0.4-0.6. Index (width_mm, sides, packing, grains)."""
     means = contact_means() if CONTACTS_CSV.is_file() else pd.DataFrame()
     rows = []
-    for (width, sides, packing), (tail, end, dirs) in GRAIN_PAIRS.items():
-        for size, suffix in (("coarse", ""), ("fine", "_fine")):
-            if size not in dirs or not (dirs[size] / "family_table.csv").is_file():
+    for (width, sides, packing), sizes in GRAIN_PAIRS.items():
+        for size, (tail, report) in sizes.items():
+            if not (report / "family_table.csv").is_file():
                 continue
-            t = pd.read_csv(dirs[size] / "family_table.csv").set_index("variant_case")
-            if not {f"lin_red_s100_p{p}{tail}{suffix}{end}" for p in ("1p9", "7p6")} <= set(t.index):
+            t = pd.read_csv(report / "family_table.csv").set_index("variant_case")
+            if not {f"lin_red_s100_p{p}{tail}" for p in ("1p9", "7p6")} <= set(t.index):
                 continue  # a report without this pair's runs (yet)
             row = {"width_mm": width, "sides": sides, "packing": packing, "grains": size}
             for p in ("1p9", "7p6"):
-                name = f"lin_red_s100_p{p}{tail}{suffix}{end}"
+                name = f"lin_red_s100_p{p}{tail}"
                 r = t.loc[name]
                 for m, short in (("force_normal_N_mean_steady", "F_n N"), ("force_rolling_N_mean_steady", "F_r N"),
                                  ("rolling_to_normal_ratio_1", "F_r/F_n"), ("n_grains", "grains"),
@@ -726,9 +732,9 @@ def main() -> None:
                 if YFIX_WINDOWS_CSV.is_file():
                     print("-- the same over other windows (contact-patch centre from lo to lo + 0.2 of the block)")
                     print(window_fits(pd.read_csv(YFIX_WINDOWS_CSV)).round(4).T.to_string())
-        if any((d / "family_table.csv").is_file() for _, _, dirs in GRAIN_PAIRS.values() for d in dirs.values()):
+        if any((d / "family_table.csv").is_file() for sizes in GRAIN_PAIRS.values() for _, d in sizes.values()):
             print()
-            print("== grain size on narrowed unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm: report linear_unrel)")
+            print("== grain size on unrelieved blocks (S 100 mm, 26 x W x 12 mm; W 33 mm, r 0.3 mm shell: linear_unrel)")
             print(grain_pairs().round(3).T.to_string())
             if PAIR_WINDOWS_CSV.is_file():
                 print("-- F_n N over windows of the cut (contact-patch centre from lo to lo + 0.2 of the block)")

@@ -1912,3 +1912,45 @@ def test_held_20mm_block_with_grains_half_the_size_shows_no_rise_of_force_with_p
             for t in ("_w20_fine_yfix", "_w20_yfix", "_k202_w20_yfix")}
     assert rise["_w20_fine_yfix"] == pytest.approx([1.20, 1.11], abs=0.01)
     assert min(rise["_w20_yfix"] + rise["_k202_w20_yfix"]) > 2.5  # F_r/F_n rises far more with p on coarse grains
+
+
+def test_33mm_block_with_a_fine_band_along_the_cut_rises_with_p_where_its_coarse_references_fall():
+    """docs/families_runs/shell_held/linear_unrel_band and linear_unrel_s016 (session 40): the 33 mm unrelieved S 100 mm
+    cut (free sides, packing 12345) with a band of r 0.35-0.5 mm grains along the cut (|y| <= 6 mm, the top 6 mm;
+    5681 grains) and its coarse reference with the same r 0.16 mm shell (2488 grains). In the case window F_n rises
+    with p on the band (x1.29) and falls on the coarse block (x0.12; x0.44 with the r 0.3 mm shell). The shell alone
+    moves the coarse ratio x0.26 in the case window while the first two windows agree within 25 %: two runs of one
+    packing drift apart late in the cut, by as much as the band moves the ratio. Over the whole cut the band does not
+    rise (windows 0.1 / 0.2 fall, x0.63 / x0.64). F_r/F_n hardly rises with p on the band (x1.10, seed x1.93)."""
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_unrel_s016.yaml", rec / f"lin_red_s100_p{p}_unrel.yaml") == {
+            ("cutter", "shell_radius_mm"): (0.16, 0.3)}
+        band = _diagnostic_changes(rec / f"lin_red_s100_p{p}_unrel_band.yaml", rec / f"lin_red_s100_p{p}_unrel_s016.yaml")
+        assert band == {("packing", "fine_zone"): (
+            {"radius_min_mm": 0.35, "radius_max_mm": 0.5, "half_width_mm": 6, "depth_mm": 6}, None)}
+        for g in ("s016", "band"):  # packing 202, queued in session 40
+            assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k202_unrel_{g}.yaml",
+                                       rec / f"lin_red_s100_p{p}_unrel_{g}.yaml") == {("packing", "seed"): (202, None)}
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    t = mod.grain_pairs()
+    c, b = t.loc[(33, "free", 12345, "coarse")], t.loc[(33, "free", 12345, "band")]
+    assert c["grains p1p9"] == c["grains p7p6"] == 2488 and b["grains p1p9"] == b["grains p7p6"] == 5681
+    assert [b["F_n N p1p9"], b["F_n N p7p6"], b["F_n p7.6/p1.9"]] == pytest.approx([94.825, 122.085, 1.287], abs=1e-3)
+    assert [c["F_n N p1p9"], c["F_n N p7p6"], c["F_n p7.6/p1.9"]] == pytest.approx([467.711, 54.643, 0.117], abs=1e-3)
+    assert [b["F_r/F_n p7.6/p1.9"], c["F_r/F_n p7.6/p1.9"]] == pytest.approx([1.097, 14.38], abs=0.01)
+    assert max(b["inside p1p9"], b["inside p7p6"], c["inside p1p9"], c["inside p7p6"]) <= 1
+    assert max(b["largest chip grains p1p9"], b["largest chip grains p7p6"]) < 40  # the block holds together
+    # the band still rides on loose grains: more grains touch the disc, the detached ones carry the normal load
+    assert min(b["touching p1p9"], b["touching p7p6"]) > max(c["touching p1p9"], c["touching p7p6"])
+    assert min(b["detached share p1p9"], b["detached share p7p6"]) > 0.99
+    r = mod.pair_window_ratios()
+    assert r.loc["_unrel_band"].tolist() == pytest.approx([0.634, 0.644, 1.247, 1.287], abs=1e-3)
+    assert r.loc["_unrel_s016"].tolist() == pytest.approx([1.312, 1.011, 0.351, 0.117], abs=1e-3)
+    assert r.loc["_unrel"].tolist() == pytest.approx([1.556, 1.260, 0.686, 0.442], abs=1e-3)
+    # the shell alone: early windows alike at both depths, the case window at p 7.6 mm x0.36
+    w = mod.grain_pair_windows()
+    shell = w.loc[["lin_red_s100_p1p9_unrel_s016", "lin_red_s100_p7p6_unrel_s016"]].to_numpy() / w.loc[
+        ["lin_red_s100_p1p9_unrel", "lin_red_s100_p7p6_unrel"]].to_numpy()
+    assert abs(shell[:, :2] - 1).max() < 0.25 and shell[1, 3] == pytest.approx(0.362, abs=1e-3)
+    assert r.loc["_unrel_s016", 0.4] / r.loc["_unrel", 0.4] == pytest.approx(0.264, abs=1e-3)

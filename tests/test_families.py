@@ -1948,6 +1948,14 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert r.loc["_unrel_band"].tolist() == pytest.approx([0.634, 0.644, 1.247, 1.287], abs=1e-3)
     assert r.loc["_unrel_s016"].tolist() == pytest.approx([1.312, 1.011, 0.351, 0.117], abs=1e-3)
     assert r.loc["_unrel"].tolist() == pytest.approx([1.556, 1.260, 0.686, 0.442], abs=1e-3)
+    # the standard errors within the runs (results.mean_standard_error per run and window, in quadrature): the band's
+    # case-window ratio is 0.4 of its error above 1, the coarse references' fall is several errors below 1
+    e = mod.pair_window_ratio_errors()
+    assert e.loc["_unrel_band"].tolist() == pytest.approx([0.331, 0.238, 0.483, 0.694], abs=1e-3)
+    assert [e.loc["_unrel_s016", 0.4], e.loc["_unrel", 0.4]] == pytest.approx([0.028, 0.123], abs=1e-3)
+    assert e.loc["_w20_fine_yfix", [0.1, 0.2]].tolist() == pytest.approx([0.225, 0.133], abs=1e-3)  # session 39's
+    assert (r.loc["_unrel_band", 0.4] - 1) / e.loc["_unrel_band", 0.4] < 0.5
+    assert (1 - r.loc[["_unrel_s016", "_unrel"], 0.4]).div(e.loc[["_unrel_s016", "_unrel"], 0.4]).min() > 4
     # the shell alone: early windows alike at both depths, the case window at p 7.6 mm x0.36
     w = mod.grain_pair_windows()
     shell = w.loc[["lin_red_s100_p1p9_unrel_s016", "lin_red_s100_p7p6_unrel_s016"]].to_numpy() / w.loc[

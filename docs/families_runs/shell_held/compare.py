@@ -12,7 +12,9 @@ block at p 1.9 and 7.6 mm (``linear_block45``, no recorded p 7.6 mm run to pair 
 S 100 mm debris-removal runs (``linear_debris``); session 37 the last five cases (48) and the whole packing-12345
 family with run.debris_removal_every; session 38 the grain-size pairs by block width (``GRAIN_PAIRS``) and the family
 cases with the side faces held (``linear_yfix``); session 39 the grain-size pair on the 20 mm block with its side
-faces held (``linear_w20_yfix``, ``linear_w20_fine_yfix``).
+faces held (``linear_w20_yfix``, ``linear_w20_fine_yfix``); session 40 the 33 mm block with a band of fine grains along
+the cut and its coarse reference (``linear_unrel_band``, ``linear_unrel_s016``), and each window's standard error
+within the run (``window_table``; ``pair_window_ratio_errors``).
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
@@ -74,7 +76,8 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: with the y faces held (``_yfix``): session 39, the fine runs stopped at the end of the patch window 0.2-0.4 (compare
 #: them over the windows, :func:`pair_window_ratios`, not over their case window), and the coarse pair on packing 202
 #: as well (no fine pair; its runs are in the same report); 33 mm free: session 40, the band pair and its coarse
-#: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell)
+#: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell), on
+#: packings 12345 and 202 (one report per grain size holds both)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -83,7 +86,9 @@ GRAIN_PAIRS = {
                           "fine": ("_w20_fine_yfix", HERE / "linear_w20_fine_yfix")},
     (20, "held", 202): {"coarse": ("_k202_w20_yfix", HERE / "linear_w20_yfix")},
     (33, "free", 12345): {"coarse": ("_unrel_s016", HERE / "linear_unrel_s016"),
-                          "band": ("_unrel_band", HERE / "linear_unrel_band")}}
+                          "band": ("_unrel_band", HERE / "linear_unrel_band")},
+    (33, "free", 202): {"coarse": ("_k202_unrel_s016", HERE / "linear_unrel_s016"),
+                        "band": ("_k202_unrel_band", HERE / "linear_unrel_band")}}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
@@ -287,7 +292,7 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
     from the run's own block, disc, penetration and travel; ``results.steady_mask`` on its parsed series): one row per
     run and window. ``parsed`` are ``deckgen parse`` folders with the run folder beside them as ``../run``."""
     from deckgen.families import middle_window, patch_travel_fraction
-    from deckgen.results import steady_mask
+    from deckgen.results import mean_standard_error, steady_mask
 
     rows = []
     for d in map(Path, parsed):
@@ -310,7 +315,9 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
             m = steady_mask(ts["time_s"], s["cut_duration_s"], w)
             rows.append({"case": s["case"], "patch_lo_1": lo, "window_start_1": w[0], "window_end_1": w[1],
                          "rows": int(m.sum()), "force_normal_N_mean_steady": ts.loc[m, "force_normal_N"].mean(),
-                         "force_rolling_N_mean_steady": ts.loc[m, "force_rolling_N"].mean()})
+                         "force_rolling_N_mean_steady": ts.loc[m, "force_rolling_N"].mean(),
+                         # the scatter within the run (rows are correlated: results.mean_standard_error), not between runs
+                         "force_normal_N_sem_steady": mean_standard_error(ts.loc[m, "force_normal_N"])["sem"]})
     return pd.DataFrame(rows)
 
 
@@ -638,6 +645,24 @@ def pair_window_ratios(windows: pd.DataFrame | None = None) -> pd.DataFrame:
     return pd.DataFrame(rows).T.rename_axis("pair")
 
 
+def pair_window_ratio_errors(windows: pd.DataFrame | None = None) -> pd.DataFrame:
+    """The standard error of each ratio of :func:`pair_window_ratios`: the two runs' relative standard errors of F_n
+    over the window (``force_normal_N_sem_steady``, ``results.mean_standard_error``) combined in quadrature, times the
+    ratio. It measures the scatter within the two runs, not between packings or runs. NaN where a run has no standard
+    error stored (windows written before session 40)."""
+    import numpy as np
+
+    w = pd.read_csv(PAIR_WINDOWS_CSV) if windows is None else windows
+    if "force_normal_N_sem_steady" not in w:
+        w = w.assign(force_normal_N_sem_steady=float("nan"))
+    rel = (w.assign(rel=w["force_normal_N_sem_steady"] / w["force_normal_N_mean_steady"])
+           .pivot(index="case", columns="patch_lo_1", values="rel"))
+    ratios = pair_window_ratios(w)
+    rows = {t: ratios.loc[t] * np.hypot(rel.loc[f"lin_red_s100_p7p6{t}"], rel.loc[f"lin_red_s100_p1p9{t}"])
+            for t in ratios.index}
+    return pd.DataFrame(rows).T.rename_axis("pair")
+
+
 def main() -> None:
     if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
         t = contact_table([Path(a) for a in sys.argv[3:]])
@@ -657,6 +682,9 @@ def main() -> None:
         t = window_table([Path(a) for a in sys.argv[3:]])
         t.to_csv(sys.argv[2], index=False, float_format="%.6g")
         print(grain_pair_windows(t).round(1).to_string())
+        print("-- F_n p 7.6 / p 1.9 mm, and its standard error within the runs")
+        print(pair_window_ratios(t).round(3).to_string())
+        print(pair_window_ratio_errors(t).round(3).to_string())
         return
     suffix = {"--windows": "", "--debris-windows": "_debris", "--yfix-windows": "_yfix"}
     if len(sys.argv) > 3 and sys.argv[1] in suffix:
@@ -739,8 +767,9 @@ def main() -> None:
             if PAIR_WINDOWS_CSV.is_file():
                 print("-- F_n N over windows of the cut (contact-patch centre from lo to lo + 0.2 of the block)")
                 print(grain_pair_windows().round(1).to_string())
-                print("-- F_n p 7.6 / p 1.9 mm over the same windows")
+                print("-- F_n p 7.6 / p 1.9 mm over the same windows, and its standard error within the runs")
                 print(pair_window_ratios().round(3).to_string())
+                print(pair_window_ratio_errors().round(3).to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

@@ -313,11 +313,12 @@ def window_table(parsed: list[Path]) -> pd.DataFrame:
                 continue
             w = middle_window(*geometry, lo, lo + 0.2)
             m = steady_mask(ts["time_s"], s["cut_duration_s"], w)
+            fn = ts.loc[m, "force_normal_N"]
             rows.append({"case": s["case"], "patch_lo_1": lo, "window_start_1": w[0], "window_end_1": w[1],
-                         "rows": int(m.sum()), "force_normal_N_mean_steady": ts.loc[m, "force_normal_N"].mean(),
+                         "rows": int(m.sum()), "force_normal_N_mean_steady": fn.mean(),
                          "force_rolling_N_mean_steady": ts.loc[m, "force_rolling_N"].mean(),
                          # the scatter within the run (rows are correlated: results.mean_standard_error), not between runs
-                         "force_normal_N_sem_steady": mean_standard_error(ts.loc[m, "force_normal_N"])["sem"]})
+                         "force_normal_N_sem_steady": mean_standard_error(fn)["sem"]})
     return pd.DataFrame(rows)
 
 
@@ -648,13 +649,10 @@ def pair_window_ratios(windows: pd.DataFrame | None = None) -> pd.DataFrame:
 def pair_window_ratio_errors(windows: pd.DataFrame | None = None) -> pd.DataFrame:
     """The standard error of each ratio of :func:`pair_window_ratios`: the two runs' relative standard errors of F_n
     over the window (``force_normal_N_sem_steady``, ``results.mean_standard_error``) combined in quadrature, times the
-    ratio. It measures the scatter within the two runs, not between packings or runs. NaN where a run has no standard
-    error stored (windows written before session 40)."""
+    ratio. It measures the scatter within the two runs, not between packings or runs."""
     import numpy as np
 
     w = pd.read_csv(PAIR_WINDOWS_CSV) if windows is None else windows
-    if "force_normal_N_sem_steady" not in w:
-        w = w.assign(force_normal_N_sem_steady=float("nan"))
     rel = (w.assign(rel=w["force_normal_N_sem_steady"] / w["force_normal_N_mean_steady"])
            .pivot(index="case", columns="patch_lo_1", values="rel"))
     ratios = pair_window_ratios(w)

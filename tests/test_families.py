@@ -1929,9 +1929,10 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
         band = _diagnostic_changes(rec / f"lin_red_s100_p{p}_unrel_band.yaml", rec / f"lin_red_s100_p{p}_unrel_s016.yaml")
         assert band == {("packing", "fine_zone"): (
             {"radius_min_mm": 0.35, "radius_max_mm": 0.5, "half_width_mm": 6, "depth_mm": 6}, None)}
-        for g in ("s016", "band"):  # packing 202, queued in session 40
-            assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k202_unrel_{g}.yaml",
-                                       rec / f"lin_red_s100_p{p}_unrel_{g}.yaml") == {("packing", "seed"): (202, None)}
+        for g in ("s016", "band"):  # packings 202 (queued in session 40) and 303 (session 41)
+            for k in (202, 303):
+                assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k{k}_unrel_{g}.yaml",
+                                           rec / f"lin_red_s100_p{p}_unrel_{g}.yaml") == {("packing", "seed"): (k, None)}
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     t = mod.grain_pairs()
     c, b = t.loc[(33, "free", 12345, "coarse")], t.loc[(33, "free", 12345, "band")]

@@ -77,7 +77,7 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: them over the windows, :func:`pair_window_ratios`, not over their case window), and the coarse pair on packing 202
 #: as well (no fine pair; its runs are in the same report); 33 mm free: session 40, the band pair and its coarse
 #: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell), on
-#: packings 12345 and 202 (one report per grain size holds both)
+#: packings 12345 and 202 (one report per grain size holds both), and 303 (session 41)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -88,7 +88,9 @@ GRAIN_PAIRS = {
     (33, "free", 12345): {"coarse": ("_unrel_s016", HERE / "linear_unrel_s016"),
                           "band": ("_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 202): {"coarse": ("_k202_unrel_s016", HERE / "linear_unrel_s016"),
-                        "band": ("_k202_unrel_band", HERE / "linear_unrel_band")}}
+                        "band": ("_k202_unrel_band", HERE / "linear_unrel_band")},
+    (33, "free", 303): {"coarse": ("_k303_unrel_s016", HERE / "linear_unrel_s016"),
+                        "band": ("_k303_unrel_band", HERE / "linear_unrel_band")}}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)

@@ -1963,3 +1963,17 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
         ["lin_red_s100_p1p9_unrel", "lin_red_s100_p7p6_unrel"]].to_numpy()
     assert abs(shell[:, :2] - 1).max() < 0.25 and shell[1, 3] == pytest.approx(0.362, abs=1e-3)
     assert r.loc["_unrel_s016", 0.4] / r.loc["_unrel", 0.4] == pytest.approx(0.264, abs=1e-3)
+    # packing 202 (session 41): the same contrast in the case window, the earlier windows not alike
+    c2, b2 = t.loc[(33, "free", 202, "coarse")], t.loc[(33, "free", 202, "band")]
+    assert c2["grains p1p9"] == 2480 and b2["grains p1p9"] == 5630
+    assert [b2["F_n N p1p9"], b2["F_n N p7p6"], b2["F_n p7.6/p1.9"]] == pytest.approx([105.984, 175.849, 1.659], abs=1e-3)
+    assert [c2["F_n N p1p9"], c2["F_n N p7p6"], c2["F_n p7.6/p1.9"]] == pytest.approx([321.185, 39.418, 0.123], abs=1e-3)
+    assert r.loc["_k202_unrel_band"].tolist() == pytest.approx([2.090, 1.094, 0.490, 1.659], abs=1e-3)
+    assert abs(r.loc["_k202_unrel_band", 0.1] / r.loc["_unrel_band", 0.1]) > 3  # window 0.1: the packings disagree
+    rep = mod.packing_replicates()
+    assert rep.loc[[12345, 202], "band/coarse"].tolist() == pytest.approx([11.02, 13.52], abs=0.01)
+    # between the two packings the case-window ratios differ less than the runs' own scatter says they could
+    spread = mod.packing_spread(packings=(12345, 202))
+    assert spread["geometric mean"].tolist() == pytest.approx([1.462, 0.120, 12.206], abs=1e-3)
+    assert (spread["log sd between packings"] < spread["log s.e. within runs (rms)"]).all()
+    assert spread.loc["band/coarse", "95% low"] > 1 and spread.loc["coarse", "95% high"] < 1

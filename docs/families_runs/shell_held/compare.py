@@ -663,6 +663,55 @@ def pair_window_ratio_errors(windows: pd.DataFrame | None = None) -> pd.DataFram
     return pd.DataFrame(rows).T.rename_axis("pair")
 
 
+def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4) -> pd.DataFrame:
+    """The band pair and its coarse reference on every packing of :data:`GRAIN_PAIRS` at this block width and sides
+    that has both in the pair windows: per packing (index) F_n p 7.6 / 1.9 mm over ``window`` (the contact-patch start;
+    0.4 is the case window) for ``band`` and ``coarse`` with their within-run standard errors
+    (:func:`pair_window_ratio_errors`), and ``band/coarse``, the band's ratio over its same-packing reference's."""
+    ratios, errors = pair_window_ratios(), pair_window_ratio_errors()
+    rows = []
+    for (w, sd, packing), sizes in GRAIN_PAIRS.items():
+        if (w, sd) != (width, sides) or not {"band", "coarse"} <= set(sizes):
+            continue
+        tails = {size: sizes[size][0] for size in ("band", "coarse")}
+        if not all(t in ratios.index for t in tails.values()):
+            continue  # not run (yet)
+        row = {"packing": packing}
+        for size, t in tails.items():
+            row[size], row[f"{size} s.e."] = ratios.loc[t, window], errors.loc[t, window]
+        row["band/coarse"] = row["band"] / row["coarse"]
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing")
+
+
+def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
+                   packings: tuple[int, ...] | None = None) -> pd.DataFrame:
+    """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse``): their number, the
+    geometric mean of the ratio and its 95 % interval from the spread between packings (Student t on the log ratios,
+    n - 1 degrees of freedom), the standard deviation of the log ratio between packings, and the root mean square of the
+    within-run relative error (s.e. / ratio, the two combined in quadrature for band/coarse). A between-packing spread
+    well above the within-run error says one run's window mean is not a measure of the case. ``packings``: only these
+    (default: every packing run)."""
+    import numpy as np
+    from scipy import stats
+
+    t = packing_replicates(width, sides, window)
+    if packings is not None:
+        t = t.loc[list(packings)]
+    rel = {size: t[f"{size} s.e."] / t[size] for size in ("band", "coarse")}
+    rel["band/coarse"] = np.hypot(rel["band"], rel["coarse"])
+    rows = []
+    for col in ("band", "coarse", "band/coarse"):
+        lg = np.log(t[col].to_numpy(dtype=float))
+        n = len(lg)
+        sd = lg.std(ddof=1) if n > 1 else float("nan")
+        half = stats.t.ppf(0.975, n - 1) * sd / np.sqrt(n) if n > 1 else float("nan")
+        rows.append({"ratio": col, "packings": n, "geometric mean": np.exp(lg.mean()),
+                     "95% low": np.exp(lg.mean() - half), "95% high": np.exp(lg.mean() + half),
+                     "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rel[col] ** 2).mean()))})
+    return pd.DataFrame(rows).set_index("ratio")
+
+
 def main() -> None:
     if len(sys.argv) > 3 and sys.argv[1] == "--contacts":
         t = contact_table([Path(a) for a in sys.argv[3:]])
@@ -770,6 +819,9 @@ def main() -> None:
                 print("-- F_n p 7.6 / p 1.9 mm over the same windows, and its standard error within the runs")
                 print(pair_window_ratios().round(3).to_string())
                 print(pair_window_ratio_errors().round(3).to_string())
+                print("-- 33 mm block, case window: the band pair and its coarse reference packing by packing, and the spread")
+                print(packing_replicates().round(3).to_string())
+                print(packing_spread().round(3).to_string())
         if WINDOWS_CSV.is_file():
             print()
             print("== the held linear runs over other windows (contact-patch centre from lo to lo + 0.2 of the block)")

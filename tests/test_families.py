@@ -1977,3 +1977,4 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert spread["geometric mean"].tolist() == pytest.approx([1.462, 0.120, 12.206], abs=1e-3)
     assert (spread["log sd between packings"] < spread["log s.e. within runs (rms)"]).all()
     assert spread.loc["band/coarse", "95% low"] > 1 and spread.loc["coarse", "95% high"] < 1
+    assert spread.loc["band/coarse", ["95% low within", "95% high within"]].tolist() == pytest.approx([5.36, 27.8], abs=0.05)

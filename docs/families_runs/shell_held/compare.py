@@ -688,8 +688,10 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
                    packings: tuple[int, ...] | None = None) -> pd.DataFrame:
     """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse``): their number, the
     geometric mean of the ratio and its 95 % interval from the spread between packings (Student t on the log ratios,
-    n - 1 degrees of freedom), the standard deviation of the log ratio between packings, and the root mean square of the
-    within-run relative error (s.e. / ratio, the two combined in quadrature for band/coarse). A between-packing spread
+    n - 1 degrees of freedom), the standard deviation of the log ratio between packings, the root mean square of the
+    within-run relative error (s.e. / ratio, the two combined in quadrature for band/coarse; a first-order log error),
+    and a 95 % interval of the geometric mean from those within-run errors alone (normal, sqrt(sum of squares) / n on the
+    log scale; with two packings the t interval has one degree of freedom and is wide). A between-packing spread
     well above the within-run error says one run's window mean is not a measure of the case. ``packings``: only these
     (default: every packing run)."""
     import numpy as np
@@ -706,9 +708,11 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
         n = len(lg)
         sd = lg.std(ddof=1) if n > 1 else float("nan")
         half = stats.t.ppf(0.975, n - 1) * sd / np.sqrt(n) if n > 1 else float("nan")
+        within = 1.959964 * float(np.sqrt((rel[col] ** 2).sum())) / n
         rows.append({"ratio": col, "packings": n, "geometric mean": np.exp(lg.mean()),
                      "95% low": np.exp(lg.mean() - half), "95% high": np.exp(lg.mean() + half),
-                     "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rel[col] ** 2).mean()))})
+                     "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rel[col] ** 2).mean())),
+                     "95% low within": np.exp(lg.mean() - within), "95% high within": np.exp(lg.mean() + within)})
     return pd.DataFrame(rows).set_index("ratio")
 
 

@@ -1974,7 +1974,11 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert rep.loc[[12345, 202], "band/coarse"].tolist() == pytest.approx([11.02, 13.52], abs=0.01)
     # between the two packings the case-window ratios differ less than the runs' own scatter says they could
     spread = mod.packing_spread(packings=(12345, 202))
-    assert spread["geometric mean"].tolist() == pytest.approx([1.462, 0.120, 12.206], abs=1e-3)
+    assert spread.loc[["band", "coarse", "band/coarse"], "geometric mean"].tolist() == pytest.approx([1.462, 0.120, 12.206],
+                                                                                                      abs=1e-3)
     assert (spread["log sd between packings"] < spread["log s.e. within runs (rms)"]).all()
     assert spread.loc["band/coarse", "95% low"] > 1 and spread.loc["coarse", "95% high"] < 1
     assert spread.loc["band/coarse", ["95% low within", "95% high within"]].tolist() == pytest.approx([5.36, 27.8], abs=0.05)
+    # the shell radius (r 0.16 against r 0.3 mm, coarse grains) moves the case-window ratio alike on both packings
+    assert rep.loc[[12345, 202], "coarse/coarse r0.3"].tolist() == pytest.approx([0.264, 0.258], abs=1e-3)
+    assert spread.loc["coarse/coarse r0.3", "95% high within"] < 0.5

@@ -91,7 +91,11 @@ GRAIN_PAIRS = {
                         "band": ("_k202_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 303): {"coarse": ("_k303_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k303_unrel_band", HERE / "linear_unrel_band")}}
-#: the grain-size pairs' runs and the 33 mm unrelieved block's (packing 12345) over PATCH_WINDOWS (``--pair-windows``)
+#: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
+#: 35 and 41) per packing: the shell-radius reference of :func:`packing_replicates`
+SHELL03_TAILS = {12345: "_unrel", 202: "_k202_unrel", 303: "_k303_unrel"}
+#: the grain-size pairs' runs and the 33 mm unrelieved block's (r 0.3 mm shell, packings 12345, 202 and 303) over
+#: PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
 #: ``deckgen.contacts`` census of every dumped step of the held linear runs (written by ``--contacts``)
 CONTACTS_CSV = HERE / "linear_contacts.csv"
@@ -667,7 +671,9 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
     """The band pair and its coarse reference on every packing of :data:`GRAIN_PAIRS` at this block width and sides
     that has both in the pair windows: per packing (index) F_n p 7.6 / 1.9 mm over ``window`` (the contact-patch start;
     0.4 is the case window) for ``band`` and ``coarse`` with their within-run standard errors
-    (:func:`pair_window_ratio_errors`), and ``band/coarse``, the band's ratio over its same-packing reference's."""
+    (:func:`pair_window_ratio_errors`), ``band/coarse``, the band's ratio over its same-packing reference's, and (33 mm
+    block, where its pair windows exist, else NaN) ``coarse r0.3`` with its error, the coarse pair with the r 0.3 mm
+    shell (:data:`SHELL03_TAILS`), and ``coarse/coarse r0.3``, the shell radius's effect on the ratio."""
     ratios, errors = pair_window_ratios(), pair_window_ratio_errors()
     rows = []
     for (w, sd, packing), sizes in GRAIN_PAIRS.items():
@@ -680,13 +686,19 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
         for size, t in tails.items():
             row[size], row[f"{size} s.e."] = ratios.loc[t, window], errors.loc[t, window]
         row["band/coarse"] = row["band"] / row["coarse"]
+        t03 = SHELL03_TAILS.get(packing) if width == 33 and sides == "free" else None
+        has03 = t03 in ratios.index
+        row["coarse r0.3"] = ratios.loc[t03, window] if has03 else float("nan")
+        row["coarse r0.3 s.e."] = errors.loc[t03, window] if has03 else float("nan")
+        row["coarse/coarse r0.3"] = row["coarse"] / row["coarse r0.3"]
         rows.append(row)
     return pd.DataFrame(rows).set_index("packing")
 
 
 def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
                    packings: tuple[int, ...] | None = None) -> pd.DataFrame:
-    """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse``): their number, the
+    """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse`` and, where every
+    packing has it, ``coarse r0.3`` and ``coarse/coarse r0.3``): their number, the
     geometric mean of the ratio and its 95 % interval from the spread between packings (Student t on the log ratios,
     n - 1 degrees of freedom), the standard deviation of the log ratio between packings, the root mean square of the
     within-run relative error (s.e. / ratio, the two combined in quadrature for band/coarse; a first-order log error),
@@ -700,10 +712,13 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
     t = packing_replicates(width, sides, window)
     if packings is not None:
         t = t.loc[list(packings)]
-    rel = {size: t[f"{size} s.e."] / t[size] for size in ("band", "coarse")}
+    rel = {size: t[f"{size} s.e."] / t[size] for size in ("band", "coarse", "coarse r0.3")}
     rel["band/coarse"] = np.hypot(rel["band"], rel["coarse"])
+    rel["coarse/coarse r0.3"] = np.hypot(rel["coarse"], rel["coarse r0.3"])
     rows = []
-    for col in ("band", "coarse", "band/coarse"):
+    for col in ("band", "coarse", "band/coarse", "coarse r0.3", "coarse/coarse r0.3"):
+        if t[col].isna().any():
+            continue  # the r 0.3 mm shell pair not run on every packing
         lg = np.log(t[col].to_numpy(dtype=float))
         n = len(lg)
         sd = lg.std(ddof=1) if n > 1 else float("nan")

@@ -14,7 +14,8 @@ family with run.debris_removal_every; session 38 the grain-size pairs by block w
 cases with the side faces held (``linear_yfix``); session 39 the grain-size pair on the 20 mm block with its side
 faces held (``linear_w20_yfix``, ``linear_w20_fine_yfix``); session 40 the 33 mm block with a band of fine grains along
 the cut and its coarse reference (``linear_unrel_band``, ``linear_unrel_s016``), and each window's standard error
-within the run (``window_table``; ``pair_window_ratio_errors``).
+within the run (``window_table``; ``pair_window_ratio_errors``); session 41 the band pair, its coarse reference and
+the r 0.3 mm shell pair on packings 202 and 303 (``packing_replicates``, ``packing_spread``).
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
@@ -92,8 +93,8 @@ GRAIN_PAIRS = {
     (33, "free", 303): {"coarse": ("_k303_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k303_unrel_band", HERE / "linear_unrel_band")}}
 #: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
-#: 35 and 41) per packing: the shell-radius reference of :func:`packing_replicates`
-SHELL03_TAILS = {12345: "_unrel", 202: "_k202_unrel", 303: "_k303_unrel"}
+#: 35 and 41), per :data:`GRAIN_PAIRS` key: the shell-radius reference of :func:`packing_replicates`
+SHELL03_TAILS = {(33, "free", 12345): "_unrel", (33, "free", 202): "_k202_unrel", (33, "free", 303): "_k303_unrel"}
 #: the grain-size pairs' runs and the 33 mm unrelieved block's (r 0.3 mm shell, packings 12345, 202 and 303) over
 #: PATCH_WINDOWS (``--pair-windows``)
 PAIR_WINDOWS_CSV = HERE / "linear_grain_pair_windows.csv"
@@ -674,10 +675,12 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
     (:func:`pair_window_ratio_errors`), ``band/coarse``, the band's ratio over its same-packing reference's, and (33 mm
     block, where its pair windows exist, else NaN) ``coarse r0.3`` with its error, the coarse pair with the r 0.3 mm
     shell (:data:`SHELL03_TAILS`), and ``coarse/coarse r0.3``, the shell radius's effect on the ratio."""
-    ratios, errors = pair_window_ratios(), pair_window_ratio_errors()
+    w = pd.read_csv(PAIR_WINDOWS_CSV)
+    ratios, errors = pair_window_ratios(w), pair_window_ratio_errors(w)
     rows = []
-    for (w, sd, packing), sizes in GRAIN_PAIRS.items():
-        if (w, sd) != (width, sides) or not {"band", "coarse"} <= set(sizes):
+    for key, sizes in GRAIN_PAIRS.items():
+        packing = key[2]
+        if key[:2] != (width, sides) or not {"band", "coarse"} <= set(sizes):
             continue
         tails = {size: sizes[size][0] for size in ("band", "coarse")}
         if not all(t in ratios.index for t in tails.values()):
@@ -686,7 +689,7 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
         for size, t in tails.items():
             row[size], row[f"{size} s.e."] = ratios.loc[t, window], errors.loc[t, window]
         row["band/coarse"] = row["band"] / row["coarse"]
-        t03 = SHELL03_TAILS.get(packing) if width == 33 and sides == "free" else None
+        t03 = SHELL03_TAILS.get(key)
         has03 = t03 in ratios.index
         row["coarse r0.3"] = ratios.loc[t03, window] if has03 else float("nan")
         row["coarse r0.3 s.e."] = errors.loc[t03, window] if has03 else float("nan")
@@ -723,7 +726,7 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
         n = len(lg)
         sd = lg.std(ddof=1) if n > 1 else float("nan")
         half = stats.t.ppf(0.975, n - 1) * sd / np.sqrt(n) if n > 1 else float("nan")
-        within = 1.959964 * float(np.sqrt((rel[col] ** 2).sum())) / n
+        within = stats.norm.ppf(0.975) * float(np.sqrt((rel[col] ** 2).sum())) / n
         rows.append({"ratio": col, "packings": n, "geometric mean": np.exp(lg.mean()),
                      "95% low": np.exp(lg.mean() - half), "95% high": np.exp(lg.mean() + half),
                      "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rel[col] ** 2).mean())),

@@ -121,3 +121,24 @@ def test_session42_cases_change_only_the_packing_seed_or_the_dumps():
     a, b = _flat(rec / "lin_red_s100_p1p9_k303_unrel_dumps.yaml"), _flat(rec / "lin_red_s100_p1p9_k303_unrel.yaml")
     assert {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)} == {("name",), ("outputs", "dump_every")}
     assert a[("outputs", "dump_every")] == 10000
+
+
+def test_the_303_r03_shallow_cut_drops_when_a_side_splits_off():
+    """piece_timeline_k303_unrel_p1p9*.csv (session 42, the run with dumps every 10000 steps): F_n peaks at ~619 N
+    just before the patch reaches 0.385 of the block; within 0.2 mm of travel 532 bonds break and a piece of 118
+    grains (then 85) separates; over the case window F_n averages under a fifth of the peak and never reaches 0.36 of
+    it; the disc never touches the piece."""
+    t = pd.read_csv(HELD / "piece_timeline_k303_unrel_p1p9.csv")
+    d = pd.read_csv(HELD / "piece_timeline_k303_unrel_p1p9_dumps.csv")
+    first = t[t["largest_piece_grains"] >= 50].iloc[0]
+    assert 0.385 < first["patch_centre_1"] < 0.395 and first["largest_piece_grains"] == 118
+    before = t[t["patch_centre_1"] < 0.385]
+    assert before["force_normal_N_mean"].max() == pytest.approx(618.6, abs=0.1)
+    assert first["bonds_broken"] - before["bonds_broken"].iloc[-1] == 532
+    case = t[(t["patch_centre_1"] >= 0.4) & (t["patch_centre_1"] <= 0.6)]
+    assert case["force_normal_N_mean"].max() < 0.36 * before["force_normal_N_mean"].max()
+    assert case["force_normal_N_mean"].mean() < 0.2 * before["force_normal_N_mean"].max()
+    assert case["largest_piece_grains"].eq(85).all() and t["bonds_broken"].iloc[-1] == 1789
+    after = d[d["step"] > first["step"]]
+    assert len(after) == 8 and after["grains_touching_chip"].eq(0).all()
+    assert (after["piece_centre_y_mm"] < -10).all() and after["piece_extent_y_mm"].min() > 13  # out to the -y face

@@ -101,6 +101,19 @@ def main(argv: list[str] | None = None) -> int:
         if tail not in REPORTS:
             raise SystemExit(f"{d}: case tail {tail!r} has no report here (fix: one of {', '.join(REPORTS)})")
         by_report.setdefault(tail, []).append(d)
+    cmp = _compare()
+    names = {d: json.loads((d / "parsed" / "summary.json").read_text())["case"] for d in args.runs}
+    # every clash is found before anything is written
+    for tail, dirs in by_report.items():
+        recorded = REPORTS[tail] / "family_table.csv"
+        clash = sorted(set(pd.read_csv(recorded)["variant_case"]) & {names[d] for d in dirs})
+        if clash:
+            raise SystemExit(f"{recorded}: already holds {', '.join(clash)} (fix: these runs were added before)")
+    census_dirs = [d for tail, dirs in by_report.items() if tail in CENSUS_TAILS for d in dirs]
+    for csv, dirs in ((cmp.PAIR_WINDOWS_CSV, args.runs), (cmp.CONTACTS_CSV, census_dirs)):
+        clash = sorted(set(pd.read_csv(csv)["case"]) & {names[d] for d in dirs})
+        if clash:
+            raise SystemExit(f"{csv}: already holds {', '.join(clash)} (fix: these runs were added before)")
     idx = packing_index(args.seed)
     with tempfile.TemporaryDirectory() as tmp:
         idx_path = Path(tmp) / "index.csv"
@@ -111,17 +124,15 @@ def main(argv: list[str] | None = None) -> int:
             new_csv = Path(tmp) / f"new{tail}.csv"
             new.to_csv(new_csv, index=False)
             recorded = report / "family_table.csv"
-            old_cases = set(pd.read_csv(recorded)["case"])
-            if old_cases & set(new["case"]):
-                raise SystemExit(f"{recorded}: already holds {', '.join(sorted(old_cases & set(new['case'])))}")
+            n_old = len(pd.read_csv(recorded))
             table = combine_tables([recorded, new_csv])
+            if len(table) != n_old + len(new):
+                raise SystemExit(f"{recorded}: a new run's family case is in the report already (fix: another seed)")
             report_table("linear_ccs", table, report)
-            print(f"{report.relative_to(ROOT)}: {len(old_cases)} recorded + {len(new)} new runs")
-    cmp = _compare()
+            print(f"{report.relative_to(ROOT)}: {n_old} recorded + {len(new)} new runs")
     windows = cmp.window_table([d / "parsed" for d in args.runs])
     _append(cmp.PAIR_WINDOWS_CSV, windows)
     print(f"{cmp.PAIR_WINDOWS_CSV.relative_to(ROOT)}: +{len(windows)} rows")
-    census_dirs = [d for tail, dirs in by_report.items() if tail in CENSUS_TAILS for d in dirs]
     if census_dirs:
         contacts = cmp.contact_table(census_dirs)
         _append(cmp.CONTACTS_CSV, contacts)

@@ -46,18 +46,20 @@ def timeline(run_dir: Path, parsed: Path, grid: int = 200, min_grains: int = 10)
         raise SystemExit(f"{run_dir}: no specimen.data: the initial bonds are unknown")
     ids = np.unique(bonds)  # bonded grains; a grain without bonds is its own component either way
     steps = ts["step"].to_numpy(np.int64)
-    grid_steps = np.unique(np.linspace(steps[0], steps[-1], grid + 1).round().astype(np.int64))
+    # grid steps are series rows (the disc's x and F_n of the same row), evenly spread over the run
+    grid_steps = np.unique(steps[np.linspace(0, len(steps) - 1, grid + 1).round().astype(np.int64)])
     rows, prev = [], grid_steps[0]
     for s in grid_steps[1:]:
         label, sizes, body = bond_components(bonds, br_pairs[br_steps <= s], ids)
         pieces = np.sort(np.delete(sizes, body))[::-1]
         m = (steps > prev) & (steps <= s)
-        x = series.iloc[series.index.get_indexer([s], method="nearest")[0]]
+        x = series.loc[s] if s in series.index else series.iloc[series.index.get_indexer([s], method="nearest")[0]]
         rows.append({"step": int(s), "time_s": float(ts.loc[m, "time_s"].iloc[-1]) if m.any() else float("nan"),
                      "patch_centre_1": (x + half_chord_m / 2) / length_m,
                      "force_normal_N_mean": float(ts.loc[m, "force_normal_N"].mean()),
                      "bonds_broken": int((br_steps <= s).sum()),
                      "largest_piece_grains": int(pieces[0]) if len(pieces) else 0,
+                     "largest_pieces": " ".join(str(int(n)) for n in pieces[:4]),  # grains of the four largest
                      "pieces": int((pieces >= min_grains).sum()),
                      "grains_in_pieces": int(pieces[pieces >= min_grains].sum())})
         prev = s
@@ -65,7 +67,8 @@ def timeline(run_dir: Path, parsed: Path, grid: int = 200, min_grains: int = 10)
 
 
 def piece_at_dumps(run_dir: Path, parsed: Path) -> pd.DataFrame:
-    """At each dumped step: the largest piece's grains, centre and extent (mm) and the contact census."""
+    """At each dumped step: the largest piece's grains, the mean, extent, smallest and largest of its grain centres
+    (mm) and the contact census."""
     from deckgen.chips import bond_components, initial_bonds
     from deckgen.contacts import census_of_parsed
     from deckgen.parse.dump import iter_frames
@@ -83,9 +86,10 @@ def piece_at_dumps(run_dir: Path, parsed: Path) -> pd.DataFrame:
         row = {"step": fr.timestep, "largest_piece_grains": int(sizes[big]) if big is not None else 0}
         if big is not None:
             xyz = rock.loc[label == big, ["x", "y", "z"]].to_numpy(float) * 1e3
-            for k, ax in enumerate("xyz"):
+            for k, ax in enumerate("xyz"):  # of the grain centres
                 row[f"piece_centre_{ax}_mm"] = float(xyz[:, k].mean())
                 row[f"piece_extent_{ax}_mm"] = float(np.ptp(xyz[:, k]))
+                row[f"piece_min_{ax}_mm"], row[f"piece_max_{ax}_mm"] = float(xyz[:, k].min()), float(xyz[:, k].max())
         rows.append(row)
     census = census_of_parsed(run_dir, parsed)[["step", "grains_touching", "grains_touching_body", "grains_touching_chip",
                                                 "grains_touching_debris", "force_z_hertz_N", "force_z_hertz_chip_N",

@@ -1994,3 +1994,20 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert s3.loc["coarse r0.3", "log sd between packings"] > 2 * s3.loc["coarse r0.3", "log s.e. within runs (rms)"]
     c3 = t.loc[(33, "free", 303, "band")]
     assert [c3["grains p1p9"], c3["F_n N p1p9"], c3["F_n N p7p6"]] == pytest.approx([5656, 64.752, 127.155], abs=1e-3)
+    # packing 404 (session 42, added by add_packing.py): the band's ratio x2.45, so over four packings its t interval
+    # (3 d.f.) and the one from the runs' own errors both lie above 1 and hold the seed's x1.76; the coarse r 0.16 mm
+    # reference falls less on 404 (x0.51) but below 1 on all four
+    b4, c4 = t.loc[(33, "free", 404, "band")], t.loc[(33, "free", 404, "coarse")]
+    assert [b4["grains p1p9"], c4["grains p1p9"]] == [5639, 2468]
+    assert [b4["F_n N p1p9"], b4["F_n N p7p6"], c4["F_n N p1p9"], c4["F_n N p7p6"]] == pytest.approx(
+        [76.984, 188.562, 341.503, 173.819], abs=1e-3)
+    assert rep.loc[404, ["band", "coarse", "band/coarse"]].tolist() == pytest.approx([2.449, 0.509, 4.812], abs=1e-3)
+    assert r.loc["_k404_unrel_band"].tolist() == pytest.approx([0.732, 0.680, 1.260, 2.449], abs=1e-3)
+    s4 = mod.packing_spread(packings=(12345, 202, 303, 404))
+    assert s4.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.790, 1.162, 2.758], abs=1e-3)
+    assert s4.loc["band", ["95% low within", "95% high within"]].tolist() == pytest.approx([1.142, 2.808], abs=1e-3)
+    assert s4.loc["band", "95% low"] > 1 and s4.loc["band", "95% low within"] > 1 and s4.loc["band", "95% high"] > 1.76
+    assert s4.loc["band", "log sd between packings"] < s4.loc["band", "log s.e. within runs (rms)"]
+    assert (rep["coarse"] < 1).all() and s4.loc["coarse", "95% high"] < 1
+    assert s4.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([9.434, 4.546, 19.581],
+                                                                                                      abs=1e-3)

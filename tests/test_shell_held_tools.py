@@ -200,3 +200,14 @@ def test_the_303_r03_shallow_cut_drops_when_a_side_splits_off():
     after = d[d["step"] > first["step"]]
     assert len(after) == 8 and after["grains_touching_chip"].eq(0).all()
     assert (after["piece_centre_y_mm"] < -10).all() and after["piece_extent_y_mm"].min() > 13  # out to the -y face
+
+
+def test_the_404_band_runs_lose_no_side():
+    """piece_timeline_k404_unrel_band_p{1p9,7p6}.csv (session 42): over the whole cut the band's largest pieces have
+    at most 22 and 33 grains (the 303 r 0.3 mm shallow cut's side: 118), and the timelines end with the bonds broken
+    that the band report records for these runs."""
+    report = pd.read_csv(HELD / "linear_unrel_band" / "family_table.csv").set_index("variant_case")
+    for p, most in (("1p9", 22), ("7p6", 33)):
+        t = pd.read_csv(HELD / f"piece_timeline_k404_unrel_band_p{p}.csv")
+        assert t["largest_piece_grains"].max() == most
+        assert t["bonds_broken"].iloc[-1] == report.loc[f"lin_red_s100_p{p}_k404_unrel_band", "bonds_broken"]

@@ -2011,3 +2011,8 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert (rep["coarse"] < 1).all() and s4.loc["coarse", "95% high"] < 1
     assert s4.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([9.434, 4.546, 19.581],
                                                                                                       abs=1e-3)
+    # the r 0.3 mm coarse pair rises on 404 too (x1.90), so two packings fall and two rise: its packing scatter is 3x its
+    # runs' errors; the shell's effect (r 0.16 over r 0.3 mm) stays below 0.3 on all four
+    assert rep.loc[404, ["coarse r0.3", "coarse/coarse r0.3"]].tolist() == pytest.approx([1.905, 0.267], abs=1e-3)
+    assert s4.loc["coarse r0.3", "log sd between packings"] > 3 * s4.loc["coarse r0.3", "log s.e. within runs (rms)"]
+    assert (rep["coarse/coarse r0.3"] < 0.3).all() and s4.loc["coarse/coarse r0.3", "95% high"] < 0.41

@@ -76,9 +76,9 @@ def test_add_packing_takes_only_packing_303s_cases_with_another_seed():
 
 
 def test_add_packing_adds_a_run_to_a_report_and_refuses_it_twice(tmp_path, monkeypatch):
-    """The write path on the engine's reference cut dressed as a packing-404 r 0.3 mm run (its case is not packing
+    """The write path on the engine's reference cut dressed as a packing-505 r 0.3 mm run (its case is not packing
     303's, so the template check, tested above, is bypassed here): the recorded report's rows stay byte for byte, one
-    row is added with the family factors of packing 303 and seed 404; a second call and a call with a broken run
+    row is added with the family factors of packing 303 and seed 505; a second call and a call with a broken run
     folder write nothing."""
     import json
     import shutil
@@ -88,7 +88,7 @@ def test_add_packing_adds_a_run_to_a_report_and_refuses_it_twice(tmp_path, monke
     x = tmp_path / "X"
     shutil.copytree(CUT, x / "run")
     spec = json.loads((x / "run" / "spec.json").read_text())
-    spec["case"]["name"], spec["case"]["packing"]["seed"] = "lin_red_s100_p1p9_k404_unrel", 404
+    spec["case"]["name"], spec["case"]["packing"]["seed"] = "lin_red_s100_p1p9_k505_unrel", 505
     (x / "run" / "spec.json").write_text(json.dumps(spec))
     parse_run(x / "run", x / "parsed")
     report = tmp_path / "linear_unrel"
@@ -99,23 +99,23 @@ def test_add_packing_adds_a_run_to_a_report_and_refuses_it_twice(tmp_path, monke
     shutil.copy(HELD / "linear_grain_pair_windows.csv", windows)
     shutil.copy(HELD / "linear_contacts.csv", contacts)
     kw = {"reports": {"_unrel": report}, "pair_windows": windows, "contacts": contacts}
-    assert mod.main(["--seed", "404", str(x)], **kw) == 0
+    assert mod.main(["--seed", "505", str(x)], **kw) == 0
     text = (report / "family_table.csv").read_text()
     assert text.startswith(recorded) and len(text.splitlines()) == len(recorded.splitlines()) + 1
     row = pd.read_csv(report / "family_table.csv").iloc[-1]
     assert (row["case"], row["variant_case"], row["packing_seed"]) == (
-        "lin_red_s100_p1p9_k404", "lin_red_s100_p1p9_k404_unrel", 404)
+        "lin_red_s100_p1p9_k505", "lin_red_s100_p1p9_k505_unrel", 505)
     assert row["penetration_full_mm"] == 1.9 and row["n_grains"] == 542
     assert (report / "trends.csv").is_file() and (report / "plots").is_dir()
     # the reference cut is too short for a patch window, and an r 0.3 mm run is not censused: both CSVs untouched
     assert windows.read_bytes() == (HELD / "linear_grain_pair_windows.csv").read_bytes()
     assert contacts.read_bytes() == (HELD / "linear_contacts.csv").read_bytes()
-    with pytest.raises(SystemExit, match="already holds lin_red_s100_p1p9_k404_unrel"):
-        mod.main(["--seed", "404", str(x)], **kw)
+    with pytest.raises(SystemExit, match="already holds lin_red_s100_p1p9_k505_unrel"):
+        mod.main(["--seed", "505", str(x)], **kw)
     broken = tmp_path / "Y"
     (broken / "run").mkdir(parents=True)
     with pytest.raises(SystemExit, match="needs run/spec.json"):
-        mod.main(["--seed", "404", str(broken), str(x)], **kw)
+        mod.main(["--seed", "505", str(broken), str(x)], **kw)
     assert (report / "family_table.csv").read_text() == text
 
 
@@ -211,3 +211,18 @@ def test_the_404_band_runs_lose_no_side():
         t = pd.read_csv(HELD / f"piece_timeline_k404_unrel_band_p{p}.csv")
         assert t["largest_piece_grains"].max() == most
         assert t["bonds_broken"].iloc[-1] == report.loc[f"lin_red_s100_p{p}_k404_unrel_band", "bonds_broken"]
+
+
+def test_the_404_r03_pair_splits_a_side_off_its_deep_cut_at_the_case_windows_end():
+    """piece_timeline_k404_unrel_p{1p9,7p6}.csv (session 42): the shallow cut loses no piece above 6 grains; the deep
+    cut's +y side (441 grains) splits off at a patch centre of 0.585-0.590, F_n falling from ~370 to ~110 N."""
+    t1 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p1p9.csv")
+    t7 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p7p6.csv")
+    d7 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p7p6_dumps.csv")
+    assert t1["largest_piece_grains"].max() == 6
+    first = t7[t7["largest_piece_grains"] >= 100].iloc[0]
+    assert first["largest_piece_grains"] == 441 and 0.585 < first["patch_centre_1"] < 0.591
+    before = t7[t7["patch_centre_1"] < 0.585]
+    assert before["force_normal_N_mean"].iloc[-3:].max() > 3 * first["force_normal_N_mean"]
+    end = d7.iloc[-1]
+    assert end["largest_piece_grains"] == 421 and end["piece_min_y_mm"] > 4 and end["piece_max_y_mm"] > 16.5

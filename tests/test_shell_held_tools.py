@@ -215,7 +215,7 @@ def test_the_404_band_runs_lose_no_side():
 
 def test_the_404_r03_pair_splits_a_side_off_its_deep_cut_at_the_case_windows_end():
     """piece_timeline_k404_unrel_p{1p9,7p6}.csv (session 42): the shallow cut loses no piece above 6 grains; the deep
-    cut's +y side (441 grains) splits off at a patch centre of 0.585-0.590, F_n falling from ~370 to ~110 N."""
+    cut's +y side (441 grains) splits off at a patch centre of 0.588-0.590, F_n falling from ~370 to ~110 N."""
     t1 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p1p9.csv")
     t7 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p7p6.csv")
     d7 = pd.read_csv(HELD / "piece_timeline_k404_unrel_p7p6_dumps.csv")

@@ -41,18 +41,19 @@ def test_packing_index_adds_a_non_family_packing_with_the_family_factors():
     assert len(mod.packing_index(303)) == len(base)
 
 
-def test_append_keeps_the_recorded_rows_byte_for_byte_and_refuses_a_case_twice(tmp_path):
+def test_appended_text_keeps_the_recorded_rows_byte_for_byte_and_refuses_a_case_twice(tmp_path):
     mod = load_script(HELD / "add_packing.py")
     csv = tmp_path / "w.csv"
     csv.write_text("case,patch_lo_1,force_normal_N_mean_steady\na,0.1,1.23456789\na,0.2,2\n")
     before = csv.read_text()
-    mod._append(csv, pd.DataFrame({"case": ["b"], "patch_lo_1": [0.1], "force_normal_N_mean_steady": [3.14159265]}))
+    csv.write_text(mod._appended_text(csv, pd.DataFrame({"case": ["b"], "patch_lo_1": [0.1],
+                                                         "force_normal_N_mean_steady": [3.14159265]})))
     text = csv.read_text()
     assert text.startswith(before) and text[len(before):] == "b,0.1,3.14159\n"
     with pytest.raises(SystemExit, match="already holds b"):
-        mod._append(csv, pd.DataFrame({"case": ["b"], "patch_lo_1": [0.2], "force_normal_N_mean_steady": [1.0]}))
+        mod._appended_text(csv, pd.DataFrame({"case": ["b"], "patch_lo_1": [0.2], "force_normal_N_mean_steady": [1.0]}))
     with pytest.raises(SystemExit, match="columns"):
-        mod._append(csv, pd.DataFrame({"case": ["c"], "force_normal_N_mean_steady": [1.0]}))
+        mod._appended_text(csv, pd.DataFrame({"case": ["c"], "force_normal_N_mean_steady": [1.0]}))
     assert csv.read_text() == text
 
 

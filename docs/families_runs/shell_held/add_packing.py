@@ -118,10 +118,6 @@ def _appended_text(csv: Path, new: pd.DataFrame) -> str:
     return text + ("" if text.endswith("\n") else "\n") + new.to_csv(index=False, header=False, float_format="%.6g")
 
 
-def _append(csv: Path, new: pd.DataFrame) -> None:
-    csv.write_text(_appended_text(csv, new))
-
-
 def main(argv: list[str] | None = None, reports: dict[str, Path] | None = None, pair_windows: Path | None = None,
          contacts: Path | None = None) -> int:
     """``reports``, ``pair_windows``, ``contacts``: other targets than the recorded ones (tests)."""

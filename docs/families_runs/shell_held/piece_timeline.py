@@ -25,58 +25,56 @@ import numpy as np
 import pandas as pd
 
 
-def timeline(run_dir: Path, parsed: Path, grid: int = 200, min_grains: int = 10) -> pd.DataFrame:
-    from deckgen.chips import bond_components, initial_bonds
-    from deckgen.families import half_chord_mm
+def _bond_record(run_dir: Path, parsed: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The run's initial bonds and its broken-bond record (steps, id pairs)."""
+    from deckgen.chips import initial_bonds
 
-    spec = json.loads((run_dir / "spec.json").read_text())
-    case = spec["case"]
-    length_m = case["specimen"]["length_mm"] * 1e-3
-    summary = json.loads((parsed / "summary.json").read_text())
-    half_chord_m = half_chord_mm(summary["cutter_radius_m"] * 1e3, case["kinematics"]["penetration_mm"]) * 1e-3
-    ts = pd.read_parquet(parsed / "timeseries.parquet")
-    series = pd.read_csv(run_dir / "series.txt", sep=r"\s+", comment="#", header=None, usecols=[0, 2],
-                         names=["step", "cutter_x_m"])
-    series = series.drop_duplicates("step", keep="last").set_index("step")["cutter_x_m"]
-    broken = pd.read_parquet(parsed / "broken.parquet")
-    br_steps = broken["step"].to_numpy(np.int64)
-    br_pairs = broken[["id1", "id2"]].to_numpy(np.int64)
     bonds = initial_bonds(run_dir)
     if bonds is None:
         raise SystemExit(f"{run_dir}: no specimen.data: the initial bonds are unknown")
+    broken = pd.read_parquet(parsed / "broken.parquet")
+    return bonds, broken["step"].to_numpy(np.int64), broken[["id1", "id2"]].to_numpy(np.int64)
+
+
+def timeline(run_dir: Path, parsed: Path, grid: int = 200, min_grains: int = 10) -> pd.DataFrame:
+    from deckgen.chips import bond_components
+    from deckgen.families import half_chord_mm
+
+    case = json.loads((run_dir / "spec.json").read_text())["case"]
+    length_m = case["specimen"]["length_mm"] * 1e-3
+    summary = json.loads((parsed / "summary.json").read_text())
+    half_chord_m = half_chord_mm(summary["cutter_radius_m"] * 1e3, case["kinematics"]["penetration_mm"]) * 1e-3
+    ts = pd.read_parquet(parsed / "timeseries.parquet", columns=["step", "time_s", "cutter_x_m", "force_normal_N"])
+    bonds, br_steps, br_pairs = _bond_record(run_dir, parsed)
     ids = np.unique(bonds)  # bonded grains; a grain without bonds is its own component either way
     steps = ts["step"].to_numpy(np.int64)
-    # grid steps are series rows (the disc's x and F_n of the same row), evenly spread over the run
-    grid_steps = np.unique(steps[np.linspace(0, len(steps) - 1, grid + 1).round().astype(np.int64)])
-    rows, prev = [], grid_steps[0]
-    for s in grid_steps[1:]:
+    # grid points are series rows (the disc's x and F_n of the same row), evenly spread over the run
+    grid_rows = np.unique(np.linspace(0, len(steps) - 1, grid + 1).round().astype(np.int64))
+    rows = []
+    for prev, i in zip(grid_rows[:-1], grid_rows[1:]):
+        s = steps[i]
         label, sizes, body = bond_components(bonds, br_pairs[br_steps <= s], ids)
         pieces = np.sort(np.delete(sizes, body))[::-1]
-        m = (steps > prev) & (steps <= s)
-        x = series.loc[s] if s in series.index else series.iloc[series.index.get_indexer([s], method="nearest")[0]]
-        rows.append({"step": int(s), "time_s": float(ts.loc[m, "time_s"].iloc[-1]) if m.any() else float("nan"),
-                     "patch_centre_1": (x + half_chord_m / 2) / length_m,
-                     "force_normal_N_mean": float(ts.loc[m, "force_normal_N"].mean()),
+        rows.append({"step": int(s), "time_s": float(ts["time_s"].iloc[i]),
+                     "patch_centre_1": (ts["cutter_x_m"].iloc[i] + half_chord_m / 2) / length_m,
+                     # the rows after the previous grid point, up to this one
+                     "force_normal_N_mean": float(ts["force_normal_N"].iloc[prev + 1:i + 1].mean()),
                      "bonds_broken": int((br_steps <= s).sum()),
                      "largest_piece_grains": int(pieces[0]) if len(pieces) else 0,
                      "largest_pieces": " ".join(str(int(n)) for n in pieces[:4]),  # grains of the four largest
                      "pieces": int((pieces >= min_grains).sum()),
                      "grains_in_pieces": int(pieces[pieces >= min_grains].sum())})
-        prev = s
     return pd.DataFrame(rows)
 
 
 def piece_at_dumps(run_dir: Path, parsed: Path) -> pd.DataFrame:
     """At each dumped step: the largest piece's grains, the mean, extent, smallest and largest of its grain centres
     (mm) and the contact census."""
-    from deckgen.chips import bond_components, initial_bonds
+    from deckgen.chips import bond_components
     from deckgen.contacts import census_of_parsed
     from deckgen.parse.dump import iter_frames
 
-    broken = pd.read_parquet(parsed / "broken.parquet")
-    br_steps = broken["step"].to_numpy(np.int64)
-    br_pairs = broken[["id1", "id2"]].to_numpy(np.int64)
-    bonds = initial_bonds(run_dir)
+    bonds, br_steps, br_pairs = _bond_record(run_dir, parsed)
     rows = []
     for fr in iter_frames(run_dir / "atoms.dump.gz", ["id", "type", "radius", "x", "y", "z"]):
         rock = fr.data[fr.data["type"] == 1]
@@ -105,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--min-grains", type=int, default=10, help="smallest piece counted in pieces / grains_in_pieces")
     args = p.parse_args(argv)
     run_dir, parsed = args.run / "run", args.run / "parsed"
-    for f in (run_dir / "spec.json", run_dir / "series.txt", parsed / "summary.json", parsed / "broken.parquet"):
+    for f in (run_dir / "spec.json", parsed / "summary.json", parsed / "timeseries.parquet", parsed / "broken.parquet"):
         if not f.is_file():
             raise SystemExit(f"{f}: missing (fix: deckgen render/run into X/run and deckgen parse X/run --out X/parsed)")
     t = timeline(run_dir, parsed, args.grid, args.min_grains)

@@ -66,6 +66,13 @@ def test_add_packing_takes_only_packing_303s_cases_with_another_seed():
         for tail in ("_unrel", "_unrel_band", "_unrel_s016"):
             case = resolved_dict(load_case(rec / f"lin_red_s100_p{p}_k404{tail}.yaml"))
             assert mod.check_template(case, 404, Path("x")) == tail
+    # packing 505's band p 1.9 mm case also dumps its grains every 10000 steps (session 43): allowed, nothing else
+    for p in ("1p9", "7p6"):
+        for tail in ("_unrel_band", "_unrel_s016"):
+            case = resolved_dict(load_case(rec / f"lin_red_s100_p{p}_k505{tail}.yaml"))
+            assert mod.check_template(case, 505, Path("x")) == tail
+    assert case["outputs"]["dump_every"] == 0
+    assert resolved_dict(load_case(rec / "lin_red_s100_p1p9_k505_unrel_band.yaml"))["outputs"]["dump_every"] == 10000
     case = resolved_dict(load_case(rec / "lin_red_s100_p1p9_k404_unrel_band.yaml"))
     with pytest.raises(SystemExit, match="packing.seed 404, not 505"):
         mod.check_template({**case, "name": "lin_red_s100_p1p9_k505_unrel_band"}, 505, Path("x"))
@@ -169,14 +176,17 @@ def _flat(path: Path) -> dict:
     return dict(walk(yaml.safe_load(path.read_text())))
 
 
-def test_session42_cases_change_only_the_packing_seed_or_the_dumps():
+def test_session42_and_43_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    for p in ("1p9", "7p6"):
-        for tail in ("_unrel", "_unrel_band", "_unrel_s016"):
-            a, b = _flat(rec / f"lin_red_s100_p{p}_k404{tail}.yaml"), _flat(rec / f"lin_red_s100_p{p}_k303{tail}.yaml")
-            diff = {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)}
-            assert diff == {("name",), ("packing", "seed")}
-            assert a[("packing", "seed")] == 404 and a[("name",)] == f"lin_red_s100_p{p}_k404{tail}"
+    for seed in (404, 505):
+        for p in ("1p9", "7p6"):
+            for tail in ("_unrel", "_unrel_band", "_unrel_s016")[seed == 505:]:  # 505: no r 0.3 mm pair
+                a = _flat(rec / f"lin_red_s100_p{p}_k{seed}{tail}.yaml")
+                b = _flat(rec / f"lin_red_s100_p{p}_k303{tail}.yaml")
+                diff = {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)}
+                dumps = {("outputs", "dump_every")} if (seed, p, tail) == (505, "1p9", "_unrel_band") else set()
+                assert diff == {("name",), ("packing", "seed")} | dumps
+                assert a[("packing", "seed")] == seed and a[("name",)] == f"lin_red_s100_p{p}_k{seed}{tail}"
     a, b = _flat(rec / "lin_red_s100_p1p9_k303_unrel_dumps.yaml"), _flat(rec / "lin_red_s100_p1p9_k303_unrel.yaml")
     assert {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)} == {("name",), ("outputs", "dump_every")}
     assert a[("outputs", "dump_every")] == 10000
@@ -227,3 +237,64 @@ def test_the_404_r03_pair_splits_a_side_off_its_deep_cut_at_the_case_windows_end
     assert before["force_normal_N_mean"].iloc[-3:].max() > 3 * first["force_normal_N_mean"]
     end = d7.iloc[-1]
     assert end["largest_piece_grains"] == 421 and end["piece_min_y_mm"] > 4 and end["piece_max_y_mm"] > 16.5
+
+
+def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
+    """groove_fill.py on the reference cut's case with its grains replaced by spheres of radius 0.05 mm at uniformly
+    random centres, overlaps allowed (a Boolean model): the solid fraction of any region is 1 - exp(-n V), n the
+    centres per volume and V a sphere's volume, whatever the region's shape, so the groove's must be 0.5 in every
+    slice; the sampled groove's cross-section is the disc's below the top."""
+    mod = load_script(HELD / "groove_fill.py")
+    case, x, r = mod.load(CUT)
+    # the rock grains only (not the shell's), radii 0.6-0.9 mm scaled by the packing and shrunk before bonding
+    assert len(x) == len(r) == 542 and 0.5e-3 < r.min() < r.max() < 0.9e-3 and r.max() / r.min() <= 0.9 / 0.6 + 1e-9
+    from deckgen.chips import groove_area
+
+    geo = mod.groove_geometry(case)
+    assert geo["centre_z_m"] - geo["radius_m"] == pytest.approx(8e-3 - 1.5e-3)  # the tip 1.5 mm below the top
+    rad = 5e-5
+    n = np.log(2.0) / (4.0 / 3.0 * np.pi * rad**3)  # centres per m^3 for a fraction of 0.5
+    # the groove's half width at the top: the tip's (0.26 mm; v_disc, tip radius 0.3 mm) plus the flank's run
+    # over the depth below the tip arc
+    half_w = 0.26e-3 + 1.5e-3 * np.tan(np.radians(case.cutter.edge_angle_deg / 2))
+    # centres over the groove and a sphere's margin on every side, the top included: the groove is bulk everywhere
+    lo, hi = np.array([-rad, -half_w - rad, 6.5e-3 - rad]), np.array([16e-3 + rad, half_w + rad, 8e-3 + rad])
+    rng = np.random.default_rng(7)
+    pts = rng.uniform(lo, hi, size=(rng.poisson(n * np.prod(hi - lo)), 3))
+    t = mod.solid_in_groove(pts, np.full(len(pts), rad), geo, 16e-3, slice_m=2e-3, step_m=2e-5, top_m=8e-3)
+    assert len(t) == 8 and t["groove_area_m2"].nunique() == 1
+    # the sampled groove is the disc's cross-section below the top (deckgen.chips.groove_area of the profile)
+    assert t["groove_area_m2"].iloc[0] == pytest.approx(groove_area(geo["profile"], geo["radius_m"], 1.5e-3), rel=0.01)
+    # one slice's fill scatters by ~0.006 (s.d.) about 0.5 (the Boolean model's covariance over 4 mm^3), the whole
+    # groove's by ~0.002
+    assert t["solid_fraction_1"].to_numpy() == pytest.approx(0.5, abs=0.02)
+    assert t["solid_points"].sum() / t["points"].sum() == pytest.approx(0.5, abs=0.008)
+    # without top_m the groove reaches up to the highest sphere top (8.1 mm), where the fill thins out
+    t2 = mod.solid_in_groove(pts, np.full(len(pts), rad), geo, 16e-3, slice_m=2e-3, step_m=2e-5)
+    assert t2["groove_area_m2"].iloc[0] > t["groove_area_m2"].iloc[0]
+    assert t2["solid_points"].sum() / t2["points"].sum() < 0.5 - 0.005
+
+
+def test_groove_fill_windows_weight_slices_by_overlap_and_correlate():
+    mod = load_script(HELD / "groove_fill.py")
+    L, h = 26e-3, 2e-3
+    edges = np.arange(0, L + 1e-9, 1e-3)
+    # full groove for x < 13 mm, empty beyond: each window's fraction is the part of its range below 13 mm
+    solid = np.where(edges[:-1] < 13e-3, 100, 0)
+    s = pd.DataFrame({"x_lo_m": edges[:-1], "x_hi_m": edges[1:], "points": 100, "solid_points": solid,
+                      "groove_area_m2": 1e-6})
+    s["grain_volume_m3"] = s["solid_points"] / s["points"] * s["groove_area_m2"] * 1e-3
+    w = mod.window_fill(s, L, h).set_index("patch_lo_1")
+    for lo in (0.1, 0.2, 0.3, 0.4):
+        for tag, (pa, pb) in mod.RANGES.items():
+            a, b = max(lo * L + pa * h, 0.0), (lo + 0.2) * L + pb * h
+            assert w.loc[lo, f"solid_fraction_{tag}_1"] == pytest.approx(np.clip((13e-3 - a) / (b - a), 0, 1))
+    assert w.loc[0.4, "solid_fraction_front_1"] == pytest.approx(1.6 / 5.2) and w.loc[0.1, "solid_fraction_touched_1"] == 1.0
+    fill = w.reset_index().assign(case="c1", penetration_mm=0.95)
+    fill2 = fill.assign(case="c2", **{c: fill[c] * 0.9 + 0.01 for c in fill if c.startswith("solid_fraction")})
+    forces = pd.concat([fill, fill2]).assign(force_normal_N_mean_steady=lambda d: 50 + 500 * d["solid_fraction_touched_1"])
+    rho = mod.against_forces(pd.concat([fill, fill2]), forces).set_index(["fill", "how"])["spearman_rho_1"]
+    assert rho[("solid_fraction_touched_1", "pooled")] == pytest.approx(1.0)
+    assert rho[("solid_fraction_touched_1", "within")] == pytest.approx(1.0)
+    with pytest.raises(SystemExit, match="no windows of c2"):
+        mod.against_forces(pd.concat([fill, fill2]), forces[forces["case"] == "c1"])

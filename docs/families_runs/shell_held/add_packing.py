@@ -12,7 +12,8 @@ A packing that is not one of the family's (``cases/linear_ccs``: 12345, 202, 303
 be variants of. Its two family rows (S 100 mm at p 1.9 and 7.6 mm) are taken from packing 303's rows of
 ``cases/linear_ccs/index.csv`` with the seed and name changed and no case file (``file`` empty). So that those factors
 are the run's, each run's resolved case (spec.json) must be packing 303's diagnostic case of the same name tail
-(``docs/families_runs/linear_fn_vs_p/lin_red_s100_p{1p9,7p6}_k303<tail>.yaml``) but for its name and packing seed.
+(``docs/families_runs/linear_fn_vs_p/lin_red_s100_p{1p9,7p6}_k303<tail>.yaml``) but for its name, packing seed and
+per-atom dump interval (:data:`FREE_FIELDS`).
 These rows are not in the family's index, so ``python -m deckgen.families combine --index`` refuses such a report;
 combine it without ``--index``.
 
@@ -75,9 +76,15 @@ def _tail(case: str, seed: int) -> str:
     raise SystemExit(f"{case}: not a run of packing {seed} (fix: cases named lin_red_s100_p{{1p9,7p6}}_k{seed}<tail>)")
 
 
+#: the fields a run may change from its template case: the name, the packing and how often the grains are dumped (dumps
+#: do not change a run: session 42's lin_red_s100_p1p9_k303_unrel_dumps gave the case-window F_n 110.915 N of
+#: lin_red_s100_p1p9_k303_unrel; the contact census then has more frames)
+FREE_FIELDS = ("name", "packing.seed", "outputs.dump_every")
+
+
 def check_template(case: dict, seed: int, where: Path) -> str:
     """The name tail of a run of packing ``seed`` whose resolved case (spec.json's ``case``) is packing 303's diagnostic
-    case of that tail but for its name and packing seed; SystemExit naming the run and the fields otherwise."""
+    case of that tail but for :data:`FREE_FIELDS`; SystemExit naming the run and the fields otherwise."""
     from deckgen.families import _diff_keys
     from deckgen.spec import load_case, resolved_dict
 
@@ -88,9 +95,9 @@ def check_template(case: dict, seed: int, where: Path) -> str:
     p = name.removeprefix("lin_red_s100_p")[:3]
     template = TEMPLATE_CASES / f"lin_red_s100_p{p}_k{TEMPLATE_SEED}{tail}.yaml"
     ref = resolved_dict(load_case(template))
-    diff = [k for k in _diff_keys(case, ref) if k not in ("name", "packing.seed")]
+    diff = [k for k in _diff_keys(case, ref) if k not in FREE_FIELDS]
     if diff:
-        raise SystemExit(f"{where}: differs from {template} in {', '.join(diff)}, not only in name and packing.seed "
+        raise SystemExit(f"{where}: differs from {template} in {', '.join(diff)}, not only in {', '.join(FREE_FIELDS)} "
                          "(fix: add runs of packing 303's diagnostic cases with another seed only)")
     if case["packing"]["seed"] != seed:
         raise SystemExit(f"{where}: packing.seed {case['packing']['seed']}, not {seed} (fix: --seed "

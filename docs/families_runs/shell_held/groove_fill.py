@@ -1,0 +1,243 @@
+"""How much rock does the disc's groove hold along the cut, in the packing as rendered (session 43)?
+
+A linear cut at penetration p removes the groove: the disc's cross-section profile (``deckgen.deck.cutter_profile``)
+below the block's nominal top, swept along x. With p 0.95 mm (the reduced p 1.9 mm cut) and grains of radius
+0.35-0.5 mm (the band) the top layer's roughness is a sizeable part of the groove, so the rock the disc meets may vary
+along the cut from the packing alone. This script measures it before any cutting: the grain volume inside the groove
+per slice of x (sample points on a regular grid in the groove, each inside a grain or not), as the solid fraction of
+the groove, and per window of the cut (``compare.PATCH_WINDOWS``: the contact-patch centre between ``lo`` and
+``lo + 0.2`` of the block length) over three ranges of x (:data:`RANGES`): the rock the patch touches in the window
+(the centre's range extended by half the patch chord either side), the centre's range, and the rock the disc's
+leading edge enters in the window.
+
+    python docs/families_runs/shell_held/groove_fill.py X [X ...] [--slice-mm 0.1] [--out CSV] [--windows-out CSV] \
+        [--pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv]
+
+``X`` is a rendered run folder (``spec.json`` and ``specimen.data``; ``deckgen render`` alone is enough, no run
+needed). The rendered grains are the packing's shrunk by ``bonds.shrink_before_bonding`` (2 %), so the packing's
+own ``packed.data`` would overstate the fill by ~6 %. Prints per run the windows' solid fraction and grain volume;
+with ``--pair-windows`` (the runs' recorded F_n per window, ``compare.py --pair-windows``) also the Spearman rank
+correlation of F_n with the fill per penetration, over all runs' windows and within each run (the fill and F_n less
+their run's mean over its windows).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+#: sample spacing [m] of the grid in the groove (0.04 mm: ~10 points across the smallest grain radius, 0.35 mm)
+STEP_M = 4e-5
+#: windows of the cut, as in compare.window_table: the contact-patch centre from lo to lo + 0.2 of the block length
+WINDOWS = (0.1, 0.2, 0.3, 0.4)
+
+
+def groove_geometry(case) -> dict[str, float | np.ndarray]:
+    """The groove's cross-section (profile polygon in (depth below the disc centre, y)), the disc centre height and
+    radius [m] of a validated linear cutting case."""
+    from deckgen.deck import cutter_profile
+
+    if case.kinematics.mode != "linear":
+        raise SystemExit(f"{case.name}: kinematics.mode is {case.kinematics.mode!r}; the groove is a linear cut's")
+    prof = cutter_profile(case)
+    radius = float(prof[:, 0].max())
+    zc = case.specimen.height_mm * 1e-3 - case.kinematics.penetration_mm * 1e-3 + radius
+    return {"profile": prof, "radius_m": radius, "centre_z_m": zc}
+
+
+def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, slice_m: float = 1e-4,
+                    step_m: float = STEP_M, top_m: float | None = None, from_m: float = 0.0) -> pd.DataFrame:
+    """Per slice of x along the block (``from_m``, default 0, to ``length_m``): the groove's sample points and how many
+    lie inside a grain.
+
+    The groove is every point inside the disc's profile (as ``deck.neighbour_groove_mask`` takes it) and below
+    ``top_m`` (default: the highest grain top, as grains standing above the block's nominal top meet the disc too); a
+    point is solid when it lies within a grain's radius of the grain's centre.
+    """
+    from matplotlib.path import Path as MplPath
+    from scipy.spatial import cKDTree
+
+    prof, zc, radius = geo["profile"], geo["centre_z_m"], geo["radius_m"]
+    top = float((x[:, 2] + r).max()) if top_m is None else top_m
+    # y over the disc's whole width: contains_points keeps the groove (the profile's flanks are single edges, so its
+    # vertices near the tip would understate the groove's width)
+    half_w = float(np.abs(prof[:, 1]).max()) + step_m
+    ys = np.arange(-half_w, half_w + step_m / 2, step_m)
+    zs = np.arange(zc - radius + step_m / 2, top, step_m)
+    yy, zz = np.meshgrid(ys, zs, indexing="ij")
+    inside = MplPath(prof).contains_points(np.column_stack([zc - zz.ravel(), yy.ravel()]))
+    yz = np.column_stack([yy.ravel()[inside], zz.ravel()[inside]])
+    tree = cKDTree(x)
+    rmax = float(r.max())
+    k = min(8, len(x))
+    rows = []
+    edges = np.arange(from_m, length_m + slice_m / 2, slice_m)
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        xs = np.arange(lo + step_m / 2, hi, step_m)
+        pts = np.column_stack([np.repeat(xs, len(yz)), np.tile(yz, (len(xs), 1))])
+        d, j = tree.query(pts, k=k, distance_upper_bound=rmax)
+        rj = np.where(j < len(x), r[np.minimum(j, len(x) - 1)], 0.0)
+        solid = (d < rj).any(axis=1)
+        rows.append({"x_lo_m": lo, "x_hi_m": hi, "points": len(pts), "solid_points": int(solid.sum()),
+                     "groove_area_m2": len(yz) * step_m**2})
+    t = pd.DataFrame(rows)
+    t["solid_fraction_1"] = t["solid_points"] / t["points"]
+    t["grain_volume_m3"] = t["solid_fraction_1"] * t["groove_area_m2"] * (t["x_hi_m"] - t["x_lo_m"])
+    return t
+
+
+#: x ranges of a window [lo, lo + 0.2] of the patch centre (fractions of the block length L; h = the patch's half chord):
+#: the rock the patch touches in the window, the patch centre's own range, the rock the disc's leading edge enters
+RANGES = {"touched": (-0.5, 0.5), "centre": (0.0, 0.0), "front": (0.5, 0.5)}
+
+
+def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> pd.DataFrame:
+    """Per window (patch centre from lo to lo + 0.2 of the block), the groove's solid fraction and grain volume over
+    each range of :data:`RANGES` (from lo * L + a * h to (lo + 0.2) * L + b * h), each slice weighted by the part of
+    it inside the range."""
+    x0, x1 = slices["x_lo_m"].to_numpy(), slices["x_hi_m"].to_numpy()
+    rows = []
+    for lo in WINDOWS:
+        row = {"patch_lo_1": lo}
+        for tag, (pa, pb) in RANGES.items():
+            a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
+            w = np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
+            row[f"solid_fraction_{tag}_1"] = float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
+            row[f"grain_volume_{tag}_mm3"] = float((w * slices["grain_volume_m3"]).sum() * 1e9)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.DataFrame:
+    """At each dumped step of a run, the groove's solid fraction over two ranges of x: ``under``, from the disc
+    centre's x to its leading edge (the centre plus the half chord: the contact patch, where the disc itself fills
+    part of the groove), and ``ahead``, from the leading edge to ``ahead_m`` beyond it (the rock the disc meets next);
+    each filled by the body (the largest component of the bond graph with the bonds broken so far,
+    ``deckgen.chips.bond_components``) and by every rock grain (``all``; all minus body is the detached grains').
+    With the step's patch centre (fraction of the block) and F_n averaged over the series rows within half the gap to
+    the dump before of it."""
+    from deckgen.chips import bond_components, initial_bonds
+    from deckgen.families import half_chord_mm
+    from deckgen.parse.dump import iter_frames
+
+    case, _, _ = load(run)
+    geo = groove_geometry(case)
+    length_m = case.specimen.length_mm * 1e-3
+    hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+    bonds = initial_bonds(run)
+    broken = pd.read_parquet(parsed / "broken.parquet", columns=["step", "id1", "id2"])
+    ts = pd.read_parquet(parsed / "timeseries.parquet", columns=["step", "cutter_x_m", "force_normal_N"])
+    top = None
+    prev = None
+    rows = []
+    for fr in iter_frames(run / "atoms.dump.gz", ["id", "type", "radius", "x", "y", "z"]):  # streamed
+        half = 0 if prev is None else (fr.timestep - prev) / 2  # half the gap to the dump before
+        prev = fr.timestep
+        rock = fr.data[fr.data["type"] == 1]
+        ids = rock["id"].to_numpy(np.int64)
+        xyz, rad = rock[["x", "y", "z"]].to_numpy(float), rock["radius"].to_numpy(float)
+        if top is None:  # the groove's top: the highest grain top before the cut
+            top = float((xyz[:, 2] + rad).max())
+        pairs = broken.loc[broken["step"] <= fr.timestep, ["id1", "id2"]].to_numpy(np.int64)
+        label, _, body = bond_components(bonds, pairs, ids)
+        xc = float(np.interp(fr.timestep, ts["step"], ts["cutter_x_m"]))
+        near = ts[(ts["step"] >= fr.timestep - half) & (ts["step"] <= fr.timestep + half)]
+        row = {"step": fr.timestep, "patch_centre_1": (xc + hc / 2) / length_m,
+               "force_normal_N_mean": float(near["force_normal_N"].mean())}
+        for where, (a, b) in (("under", (xc, xc + hc)), ("ahead", (xc + hc, xc + hc + ahead_m))):
+            a, b = max(a, 0.0), min(b, length_m)
+            for tag, keep in (("body", label == body), ("all", np.ones(len(ids), bool))):
+                if b - a < 1e-4:  # the range is off the block
+                    row[f"solid_fraction_{tag}_{where}_1"] = np.nan
+                    continue
+                t = solid_in_groove(xyz[keep], rad[keep], geo, b, slice_m=b - a, top_m=top, from_m=a)
+                row[f"solid_fraction_{tag}_{where}_1"] = float(t["solid_points"].sum() / t["points"].sum())
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def against_forces(fill: pd.DataFrame, pair_windows: pd.DataFrame) -> pd.DataFrame:
+    """Spearman's rho (and its p) of the windows' F_n against their fill, per penetration: ``pooled`` over every run's
+    windows, ``within`` after taking each run's mean over its windows off both (the packing's level left out)."""
+    from scipy.stats import spearmanr
+
+    f = pair_windows[["case", "patch_lo_1", "force_normal_N_mean_steady"]]
+    m = fill.merge(f, on=["case", "patch_lo_1"], how="inner", validate="one_to_one")
+    missing = sorted(set(fill["case"]) - set(m["case"]))
+    if missing:
+        raise SystemExit(f"--pair-windows has no windows of {', '.join(missing)} (fix: pass the runs' pair windows)")
+    rows = []
+    for pen, g in m.groupby("penetration_mm"):
+        for metric in (f"solid_fraction_{tag}_1" for tag in RANGES):
+            for how in ("pooled", "within"):
+                x, y = g[metric], g["force_normal_N_mean_steady"]
+                if how == "within":
+                    x = x - g.groupby("case")[metric].transform("mean")
+                    y = y - g.groupby("case")["force_normal_N_mean_steady"].transform("mean")
+                rho, p = spearmanr(x, y)
+                rows.append({"penetration_mm": pen, "fill": metric, "how": how, "runs": g["case"].nunique(),
+                             "windows": len(g), "spearman_rho_1": rho, "p_1": p})
+    return pd.DataFrame(rows)
+
+
+def load(run: Path):
+    """(case, rock grain positions [m], radii [m]) of a rendered run folder."""
+    from deckgen.datafile import iter_section
+    from deckgen.spec import Case
+
+    spec = json.loads((run / "spec.json").read_text())["case"]
+    case = Case.model_validate({k: v for k, v in spec.items() if k != "test"})
+    # the rendered data file is atom_style bpm/sphere: id molecule type diameter density x y z
+    raw = np.array([[float(v) for v in f[:8]] for _, f in iter_section(run / "specimen.data", "Atoms")])
+    rock = raw[:, 2] == 1
+    return case, raw[rock, 5:8], raw[rock, 3] / 2.0
+
+
+def main(argv: list[str] | None = None) -> int:
+    from deckgen.families import half_chord_mm
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("runs", nargs="+", type=Path)
+    ap.add_argument("--slice-mm", type=float, default=0.1)
+    ap.add_argument("--out", type=Path, help="per-slice table (CSV)")
+    ap.add_argument("--windows-out", type=Path, help="per-window table (CSV)")
+    ap.add_argument("--pair-windows", type=Path, help="the runs' F_n per window (compare.py --pair-windows CSV)")
+    a = ap.parse_args(argv)
+    all_slices, all_windows = [], []
+    for run in a.runs:
+        for need in ("spec.json", "specimen.data"):
+            if not (run / need).is_file():
+                raise SystemExit(f"{run}: no {need}; give a folder written by deckgen render")
+        case, x, r = load(run)
+        length_m = case.specimen.length_mm * 1e-3
+        geo = groove_geometry(case)
+        slices = solid_in_groove(x, r, geo, length_m, a.slice_mm * 1e-3)
+        hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+        win = window_fill(slices, length_m, hc)
+        for t in (slices, win):
+            t.insert(0, "penetration_mm", case.kinematics.penetration_mm)
+            t.insert(0, "packing_seed", case.packing.seed)
+            t.insert(0, "case", case.name)
+        all_slices.append(slices)
+        all_windows.append(win)
+        print(f"== {case.name} (packing {case.packing.seed}, {len(x)} rock grains): groove solid fraction "
+              f"{slices['solid_points'].sum() / slices['points'].sum():.4f} over the block")
+        print(win.drop(columns=["case", "packing_seed", "penetration_mm"]).to_string(
+            index=False, float_format=lambda v: f"{v:.4f}"))
+    if a.out:
+        pd.concat(all_slices).to_csv(a.out, index=False, float_format="%.6g")
+    if a.windows_out:
+        pd.concat(all_windows).to_csv(a.windows_out, index=False, float_format="%.6g")
+    if a.pair_windows:
+        print("== F_n of each window against the groove's fill (Spearman)")
+        print(against_forces(pd.concat(all_windows), pd.read_csv(a.pair_windows)).to_string(
+            index=False, float_format=lambda v: f"{v:.3f}"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

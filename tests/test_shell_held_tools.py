@@ -298,3 +298,23 @@ def test_groove_fill_windows_weight_slices_by_overlap_and_correlate():
     assert rho[("solid_fraction_touched_1", "within")] == pytest.approx(1.0)
     with pytest.raises(SystemExit, match="no windows of c2"):
         mod.against_forces(pd.concat([fill, fill2]), forces[forces["case"] == "c1"])
+
+
+def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
+    """groove_fill.py --dumps on ref_cut: before any bond breaks the body is all the rock; when the 18-grain piece
+    breaks off ahead of the disc (piece_timeline: >= 10 grains at step 29400) the groove ahead is still full of rock
+    but hardly any of it is the body's."""
+    mod = load_script(HELD / "groove_fill.py")
+    x, _ = cut_folder
+    d = mod.body_fill_at_dumps(x / "run", x / "parsed")
+    assert d["step"].tolist() == list(range(0, 42001, 7000))
+    assert np.isnan(d["solid_fraction_body_under_1"].iloc[0])  # the disc is not over the block yet
+    same = d["step"] <= 21000  # no bond broken yet (the first break is after step 21000)
+    assert (d.loc[same, "solid_fraction_body_ahead_1"] == d.loc[same, "solid_fraction_all_ahead_1"]).all()
+    assert d["solid_fraction_all_ahead_1"].tolist() == pytest.approx([0.485, 0.571, 0.558, 0.530, 0.549, 0.480, 0.526],
+                                                                      abs=1e-3)
+    assert d["solid_fraction_body_ahead_1"].iloc[4:].tolist() == pytest.approx([0.103, 0.099, 0.109], abs=1e-3)
+    assert d["force_normal_N_mean"].iloc[3] == pytest.approx(52.535, abs=1e-3)
+    ts = pd.read_parquet(x / "parsed" / "timeseries.parquet")
+    m = (ts["step"] >= 21000 - 3500) & (ts["step"] <= 21000 + 3500)
+    assert d["force_normal_N_mean"].iloc[3] == pytest.approx(ts.loc[m, "force_normal_N"].mean())

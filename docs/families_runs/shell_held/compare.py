@@ -711,8 +711,8 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
 
 def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
                    packings: tuple[int, ...] | None = None) -> pd.DataFrame:
-    """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse`` and, where every
-    packing has it, ``coarse r0.3`` and ``coarse/coarse r0.3``): their number, the
+    """Across the packings of :func:`packing_replicates` (rows ``band``, ``coarse``, ``band/coarse``, ``coarse r0.3``
+    and ``coarse/coarse r0.3``, each over the packings that have it, at least two): their number, the
     geometric mean of the ratio and its 95 % interval from the spread between packings (Student t on the log ratios,
     n - 1 degrees of freedom), the standard deviation of the log ratio between packings, the root mean square of the
     within-run relative error (s.e. / ratio, the two combined in quadrature for band/coarse; a first-order log error),
@@ -731,16 +731,18 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
     rel["coarse/coarse r0.3"] = np.hypot(rel["coarse"], rel["coarse r0.3"])
     rows = []
     for col in ("band", "coarse", "band/coarse", "coarse r0.3", "coarse/coarse r0.3"):
-        if t[col].isna().any():
-            continue  # the r 0.3 mm shell pair not run on every packing
-        lg = np.log(t[col].to_numpy(dtype=float))
+        ok = t[col].notna()  # the r 0.3 mm shell pair was not run on every packing (505, session 43)
+        if ok.sum() < 2:
+            continue
+        lg = np.log(t.loc[ok, col].to_numpy(dtype=float))
         n = len(lg)
         sd = lg.std(ddof=1) if n > 1 else float("nan")
         half = stats.t.ppf(0.975, n - 1) * sd / np.sqrt(n) if n > 1 else float("nan")
-        within = stats.norm.ppf(0.975) * float(np.sqrt((rel[col] ** 2).sum())) / n
+        rc = rel[col][ok]
+        within = stats.norm.ppf(0.975) * float(np.sqrt((rc ** 2).sum())) / n
         rows.append({"ratio": col, "packings": n, "geometric mean": np.exp(lg.mean()),
                      "95% low": np.exp(lg.mean() - half), "95% high": np.exp(lg.mean() + half),
-                     "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rel[col] ** 2).mean())),
+                     "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rc ** 2).mean())),
                      "95% low within": np.exp(lg.mean() - within), "95% high within": np.exp(lg.mean() + within)})
     return pd.DataFrame(rows).set_index("ratio")
 

@@ -12,13 +12,16 @@ leading edge enters in the window.
 
     python docs/families_runs/shell_held/groove_fill.py X [X ...] [--slice-mm 0.1] [--out CSV] [--windows-out CSV] \
         [--pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv]
+    python docs/families_runs/shell_held/groove_fill.py --dumps X [X ...] [--ahead-mm 2] [--out CSV]
 
 ``X`` is a rendered run folder (``spec.json`` and ``specimen.data``; ``deckgen render`` alone is enough, no run
 needed). The rendered grains are the packing's shrunk by ``bonds.shrink_before_bonding`` (2 %), so the packing's
 own ``packed.data`` would overstate the fill by ~6 %. Prints per run the windows' solid fraction and grain volume;
 with ``--pair-windows`` (the runs' recorded F_n per window, ``compare.py --pair-windows``) also the Spearman rank
 correlation of F_n with the fill per penetration, over all runs' windows and within each run (the fill and F_n less
-their run's mean over its windows).
+their run's mean over its windows). With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead:
+at each dump the groove's fill under the disc and just ahead of it, by the body and by every grain
+(:func:`body_fill_at_dumps`): where the rock the disc meets next is still part of the body, loose, or gone.
 """
 from __future__ import annotations
 
@@ -206,7 +209,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, help="per-slice table (CSV)")
     ap.add_argument("--windows-out", type=Path, help="per-window table (CSV)")
     ap.add_argument("--pair-windows", type=Path, help="the runs' F_n per window (compare.py --pair-windows CSV)")
+    ap.add_argument("--dumps", action="store_true",
+                    help="each argument is a folder X with X/run (run) and X/parsed (deckgen parse): the fill under and "
+                         "ahead of the disc at each dump (body_fill_at_dumps) instead")
+    ap.add_argument("--ahead-mm", type=float, default=2.0, help="--dumps: how far beyond the disc's leading edge")
     a = ap.parse_args(argv)
+    if a.dumps:
+        tables = []
+        for x in a.runs:
+            for need in (x / "run" / "spec.json", x / "run" / "atoms.dump.gz", x / "parsed" / "broken.parquet"):
+                if not need.is_file():
+                    raise SystemExit(f"{need}: missing (fix: deckgen render/run into X/run, deckgen parse X/run --out "
+                                     "X/parsed)")
+            d = body_fill_at_dumps(x / "run", x / "parsed", a.ahead_mm * 1e-3)
+            d.insert(0, "case", json.loads((x / "run" / "spec.json").read_text())["case"]["name"])
+            tables.append(d)
+            with pd.option_context("display.width", 250, "display.max_columns", 20):
+                print(d.drop(columns="case").round(3).to_string(index=False))
+        if a.out:
+            pd.concat(tables).to_csv(a.out, index=False, float_format="%.6g")
+        return 0
     all_slices, all_windows = [], []
     for run in a.runs:
         for need in ("spec.json", "specimen.data"):

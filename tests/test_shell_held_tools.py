@@ -254,8 +254,8 @@ def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
     assert geo["centre_z_m"] - geo["radius_m"] == pytest.approx(8e-3 - 1.5e-3)  # the tip 1.5 mm below the top
     rad = 5e-5
     n = np.log(2.0) / (4.0 / 3.0 * np.pi * rad**3)  # centres per m^3 for a fraction of 0.5
-    # the groove's half width at the top: the tip's (0.26 mm; v_disc, tip radius 0.3 mm) plus the flank's run
-    # over the depth below the tip arc
+    # the groove's half width at the top, bounded above: the tip arc's (0.26 mm; v_disc, tip radius 0.3 mm) plus the
+    # flank's run over the whole 1.5 mm (the true one, 1.04 mm, is over 1.35 mm)
     half_w = 0.26e-3 + 1.5e-3 * np.tan(np.radians(case.cutter.edge_angle_deg / 2))
     # centres over the groove and a sphere's margin on every side, the top included: the groove is bulk everywhere
     lo, hi = np.array([-rad, -half_w - rad, 6.5e-3 - rad]), np.array([16e-3 + rad, half_w + rad, 8e-3 + rad])
@@ -269,6 +269,16 @@ def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
     # groove's by ~0.002
     assert t["solid_fraction_1"].to_numpy() == pytest.approx(0.5, abs=0.02)
     assert t["solid_points"].sum() / t["points"].sum() == pytest.approx(0.5, abs=0.008)
+    # two radii (0.03 and 0.08 mm), each with half the n V: the fill is still 1 - exp(-sum n_i V_i) = 0.5, and a point
+    # in a large sphere may have several small spheres' centres nearer than the large one's (groove_fill.NEAREST)
+    radii = np.array([3e-5, 8e-5])
+    n2 = np.log(2.0) / 2 / (4.0 / 3.0 * np.pi * radii**3)
+    lo2, hi2 = lo - (radii[1] - rad), hi + (radii[1] - rad)
+    both = [rng.uniform(lo2, hi2, size=(rng.poisson(ni * np.prod(hi2 - lo2)), 3)) for ni in n2]
+    t3 = mod.solid_in_groove(np.vstack(both), np.repeat(radii, [len(b) for b in both]), geo, 16e-3, slice_m=4e-3,
+                             step_m=2e-5, top_m=8e-3)
+    assert t3["solid_points"].sum() / t3["points"].sum() == pytest.approx(0.5, abs=0.01)
+    assert t3["points"].nunique() == 1  # every slice sampled alike
     # without top_m the groove reaches up to the highest sphere top (8.1 mm), where the fill thins out
     t2 = mod.solid_in_groove(pts, np.full(len(pts), rad), geo, 16e-3, slice_m=2e-3, step_m=2e-5)
     assert t2["groove_area_m2"].iloc[0] > t["groove_area_m2"].iloc[0]
@@ -290,14 +300,28 @@ def test_groove_fill_windows_weight_slices_by_overlap_and_correlate():
             a, b = max(lo * L + pa * h, 0.0), (lo + 0.2) * L + pb * h
             assert w.loc[lo, f"solid_fraction_{tag}_1"] == pytest.approx(np.clip((13e-3 - a) / (b - a), 0, 1))
     assert w.loc[0.4, "solid_fraction_front_1"] == pytest.approx(1.6 / 5.2) and w.loc[0.1, "solid_fraction_touched_1"] == 1.0
-    fill = w.reset_index().assign(case="c1", penetration_mm=0.95)
-    fill2 = fill.assign(case="c2", **{c: fill[c] * 0.9 + 0.01 for c in fill if c.startswith("solid_fraction")})
-    forces = pd.concat([fill, fill2]).assign(force_normal_N_mean_steady=lambda d: 50 + 500 * d["solid_fraction_touched_1"])
-    rho = mod.against_forces(pd.concat([fill, fill2]), forces).set_index(["fill", "how"])["spearman_rho_1"]
-    assert rho[("solid_fraction_touched_1", "pooled")] == pytest.approx(1.0)
-    assert rho[("solid_fraction_touched_1", "within")] == pytest.approx(1.0)
+    # two runs whose F_n follows the fill within each run, while the run with more fill has the lower F_n: the
+    # pooled rank correlation is weak, within the runs it is 1
+    fill = pd.DataFrame({"patch_lo_1": [0.1, 0.2, 0.3, 0.4], "case": "c1", "penetration_mm": 0.95,
+                         **{f"solid_fraction_{tag}_1": [0.50, 0.53, 0.52, 0.49] for tag in mod.RANGES}})
+    fill2 = fill.assign(case="c2", **{f"solid_fraction_{tag}_1": [0.81, 0.80, 0.83, 0.79] for tag in mod.RANGES})
+    both = pd.concat([fill, fill2])
+    forces = both.assign(force_normal_N_mean_steady=lambda d: 500 * d["solid_fraction_touched_1"]
+                         - 400 * (d["case"] == "c2"))
+    rho = mod.against_forces(both, forces).set_index(["fill", "how"])
+    assert rho.loc[("solid_fraction_touched_1", "within"), "spearman_rho_1"] == pytest.approx(1.0)
+    assert rho.loc[("solid_fraction_touched_1", "pooled"), "spearman_rho_1"] < 0.5
+    assert rho.loc[("solid_fraction_touched_1", "within-run"), "spearman_rho_1"] == pytest.approx(1.0)
+    # the exact within-run permutation p: each run's own rho is 1 for 1 of its 24 orders, and -1 for 1 (4 distinct
+    # values; ties in the touched fill make fewer) -- with two runs a mean of 1 has p = 2 / 24**2 at least
+    obs, p = mod.within_run_permutation([(np.arange(4.0), np.arange(4.0)), (np.arange(4.0), np.arange(4.0) * 2)])
+    assert obs == 1.0 and p == pytest.approx(2 / 24**2)
+    # one run, two adjacent swaps: rho = 1 - sum d^2 / 10 = 0.6; of the 24 orders 5 have sum d^2 <= 4 (the identity,
+    # 3 single adjacent swaps, this one) and 5 mirror them, so p = 10 / 24
+    obs, p = mod.within_run_permutation([(np.arange(4.0), np.array([1.0, 0.0, 3.0, 2.0]))])
+    assert obs == pytest.approx(0.6) and p == pytest.approx(10 / 24)
     with pytest.raises(SystemExit, match="no windows of c2"):
-        mod.against_forces(pd.concat([fill, fill2]), forces[forces["case"] == "c1"])
+        mod.against_forces(both, forces[forces["case"] == "c1"])
 
 
 def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
@@ -314,7 +338,11 @@ def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
     assert d["solid_fraction_all_ahead_1"].tolist() == pytest.approx([0.485, 0.571, 0.558, 0.530, 0.549, 0.480, 0.526],
                                                                       abs=1e-3)
     assert d["solid_fraction_body_ahead_1"].iloc[4:].tolist() == pytest.approx([0.103, 0.099, 0.109], abs=1e-3)
-    assert d["force_normal_N_mean"].iloc[3] == pytest.approx(52.535, abs=1e-3)
+    # F_n since the dump before and up to the dump after: the disc loads the rock before the piece goes, not after
+    assert np.isnan(d["force_normal_N_before"].iloc[0])
+    assert d["force_normal_N_before"].iloc[4] == pytest.approx(64.864, abs=1e-3)
+    assert d["force_normal_N_after"].iloc[4] == pytest.approx(6.124, abs=1e-3)
     ts = pd.read_parquet(x / "parsed" / "timeseries.parquet")
-    m = (ts["step"] >= 21000 - 3500) & (ts["step"] <= 21000 + 3500)
-    assert d["force_normal_N_mean"].iloc[3] == pytest.approx(ts.loc[m, "force_normal_N"].mean())
+    m = (ts["step"] > 21000) & (ts["step"] <= 28000)
+    assert d["force_normal_N_before"].iloc[4] == pytest.approx(ts.loc[m, "force_normal_N"].mean())
+    assert d["force_normal_N_after"].iloc[3] == pytest.approx(d["force_normal_N_before"].iloc[4], abs=1.0)  # 1 row apart

@@ -21,7 +21,6 @@ same cases; then the finer shell on session 31's unrelieved linear cut (:func:`u
 from __future__ import annotations
 
 import functools
-import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -39,11 +38,9 @@ QUANTITIES = {"F_n": "force_normal_N", "F_r": "force_rolling_N", "F_s": "force_s
 @functools.cache
 def _linear_compare():
     """The packing-mean and ratio rules of the session-31 comparison (one rule for both families), loaded once."""
-    path = HERE.parent / "linear_fn_vs_p" / "compare.py"
-    spec = importlib.util.spec_from_file_location("linear_fn_vs_p_compare", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    from deckgen.scriptload import load_script
+
+    return load_script(HERE.parent / "linear_fn_vs_p" / "compare.py", "linear_fn_vs_p_compare")
 
 
 def _same_grains(a: pd.DataFrame, b: pd.DataFrame, what: str) -> None:

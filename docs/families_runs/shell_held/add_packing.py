@@ -24,7 +24,6 @@ Each argument is a folder ``X`` with ``X/run`` (the rendered run) and ``X/parsed
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import json
 import sys
 import tempfile
@@ -46,10 +45,9 @@ TEMPLATE_CASES = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
 
 
 def _compare():
-    spec = importlib.util.spec_from_file_location("shell_held_compare", HERE / "compare.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    from deckgen.scriptload import load_script
+
+    return load_script(HERE / "compare.py", "shell_held_compare")
 
 
 def packing_index(seed: int) -> pd.DataFrame:

@@ -39,7 +39,6 @@ eq. 7 form and the family's trends on the held runs beside the recorded runs of 
 """
 from __future__ import annotations
 
-import importlib.util
 import json
 import sys
 from pathlib import Path
@@ -115,11 +114,9 @@ YFIX_DIR = HERE / "linear_yfix"
 
 def load_gain_row():
     """``gain_row`` of ../rotary_shell0p5/compare.py (geometric mean of paired ratios with its 95 % t interval)."""
-    path = RUNS / "rotary_shell0p5" / "compare.py"
-    spec = importlib.util.spec_from_file_location("rotary_shell0p5_compare", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod.gain_row
+    from deckgen.scriptload import load_script
+
+    return load_script(RUNS / "rotary_shell0p5" / "compare.py", "rotary_shell0p5_compare").gain_row
 
 
 def _has(kind: str) -> bool:

@@ -17,9 +17,10 @@ leading edge enters in the window.
 ``X`` is a rendered run folder (``spec.json`` and ``specimen.data``; ``deckgen render`` alone is enough, no run
 needed). The rendered grains are the packing's shrunk by ``bonds.shrink_before_bonding`` (2 %), so the packing's
 own ``packed.data`` would overstate the fill by ~6 %. Prints per run the windows' solid fraction and grain volume;
-with ``--pair-windows`` (the runs' recorded F_n per window, ``compare.py --pair-windows``) also the Spearman rank
-correlation of F_n with the fill per penetration, over all runs' windows and within each run (the fill and F_n less
-their run's mean over its windows). With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead:
+with ``--pair-windows`` (the runs' recorded F_n per window, ``compare.py --pair-windows``) also the rank correlation of
+F_n with the fill per penetration (:func:`against_forces`). These correlations describe the recorded runs; the windows
+overlap and a trend along the cut shared by the runs can make a link where there is none (the ``two-way`` rows take
+it off), so they are not tests of a cause. With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead:
 at each dump the groove's fill under the disc and just ahead of it, by the body and by every grain
 (:func:`body_fill_at_dumps`): where the rock the disc meets next is still part of the body, loose, or gone.
 """
@@ -33,8 +34,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-#: sample spacing [m] of the grid in the groove (0.04 mm: ~10 points across the smallest grain radius, 0.35 mm)
+#: sample spacing [m] of the grid in the groove (0.04 mm: ~9 points across the smallest grain radius, 0.35 mm)
 STEP_M = 4e-5
+#: nearest grain centres tested per sample point (a point may lie in a large grain whose centre is farther than some
+#: small grains' centres; session 43's review found no miss with 8 on the band's 0.35 / 1.0 mm grains, 16 for margin)
+NEAREST = 16
 #: windows of the cut, as in compare.window_table: the contact-patch centre from lo to lo + 0.2 of the block length
 WINDOWS = (0.1, 0.2, 0.3, 0.4)
 
@@ -46,6 +50,9 @@ def groove_geometry(case) -> dict[str, float | np.ndarray]:
 
     if case.kinematics.mode != "linear":
         raise SystemExit(f"{case.name}: kinematics.mode is {case.kinematics.mode!r}; the groove is a linear cut's")
+    if case.cutter.kind not in ("ccs_disc", "v_disc") or case.cutter.tilt_deg != 0:
+        raise SystemExit(f"{case.name}: cutter {case.cutter.kind!r} tilted {case.cutter.tilt_deg} deg; the groove is the "
+                         "profile of an untilted ccs_disc or v_disc swept along x")
     prof = cutter_profile(case)
     radius = float(prof[:, 0].max())
     zc = case.specimen.height_mm * 1e-3 - case.kinematics.penetration_mm * 1e-3 + radius
@@ -76,11 +83,13 @@ def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, sl
     yz = np.column_stack([yy.ravel()[inside], zz.ravel()[inside]])
     tree = cKDTree(x)
     rmax = float(r.max())
-    k = min(8, len(x))
+    k = min(NEAREST, len(x))
     rows = []
-    edges = np.arange(from_m, length_m + slice_m / 2, slice_m)
+    # slices of equal length covering from_m to length_m, each sampled on the same number of evenly spaced planes
+    edges = np.linspace(from_m, length_m, max(1, round((length_m - from_m) / slice_m)) + 1)
     for lo, hi in zip(edges[:-1], edges[1:]):
-        xs = np.arange(lo + step_m / 2, hi, step_m)
+        n = max(1, round((hi - lo) / step_m))
+        xs = lo + (np.arange(n) + 0.5) * (hi - lo) / n
         pts = np.column_stack([np.repeat(xs, len(yz)), np.tile(yz, (len(xs), 1))])
         d, j = tree.query(pts, k=k, distance_upper_bound=rmax)
         rj = np.where(j < len(x), r[np.minimum(j, len(x) - 1)], 0.0)
@@ -120,37 +129,31 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
     centre's x to its leading edge (the centre plus the half chord: the contact patch, where the disc itself fills
     part of the groove), and ``ahead``, from the leading edge to ``ahead_m`` beyond it (the rock the disc meets next);
     each filled by the body (the largest component of the bond graph with the bonds broken so far,
-    ``deckgen.chips.bond_components``) and by every rock grain (``all``; all minus body is the detached grains').
-    With the step's patch centre (fraction of the block) and F_n averaged over the series rows within half the gap to
-    the dump before of it."""
+    ``deckgen.chips.bond_components``) and by every rock grain (``all``; all minus body is the detached grains'). The
+    groove's top is the rendered packing's highest grain top. With the step's patch centre (fraction of the block) and
+    F_n averaged over the series rows since the dump before (``force_normal_N_before``, NaN at the first dump) and up to
+    the dump after (``force_normal_N_after``; the last dump's up to the series' end)."""
     from deckgen.chips import bond_components, initial_bonds
     from deckgen.families import half_chord_mm
     from deckgen.parse.dump import iter_frames
 
-    case, _, _ = load(run)
+    case, x0, r0 = load(run)
+    top = float((x0[:, 2] + r0).max())
     geo = groove_geometry(case)
     length_m = case.specimen.length_mm * 1e-3
     hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
     bonds = initial_bonds(run)
     broken = pd.read_parquet(parsed / "broken.parquet", columns=["step", "id1", "id2"])
     ts = pd.read_parquet(parsed / "timeseries.parquet", columns=["step", "cutter_x_m", "force_normal_N"])
-    top = None
-    prev = None
     rows = []
     for fr in iter_frames(run / "atoms.dump.gz", ["id", "type", "radius", "x", "y", "z"]):  # streamed
-        half = 0 if prev is None else (fr.timestep - prev) / 2  # half the gap to the dump before
-        prev = fr.timestep
         rock = fr.data[fr.data["type"] == 1]
         ids = rock["id"].to_numpy(np.int64)
         xyz, rad = rock[["x", "y", "z"]].to_numpy(float), rock["radius"].to_numpy(float)
-        if top is None:  # the groove's top: the highest grain top before the cut
-            top = float((xyz[:, 2] + rad).max())
         pairs = broken.loc[broken["step"] <= fr.timestep, ["id1", "id2"]].to_numpy(np.int64)
         label, _, body = bond_components(bonds, pairs, ids)
         xc = float(np.interp(fr.timestep, ts["step"], ts["cutter_x_m"]))
-        near = ts[(ts["step"] >= fr.timestep - half) & (ts["step"] <= fr.timestep + half)]
-        row = {"step": fr.timestep, "patch_centre_1": (xc + hc / 2) / length_m,
-               "force_normal_N_mean": float(near["force_normal_N"].mean())}
+        row = {"step": fr.timestep, "patch_centre_1": (xc + hc / 2) / length_m}
         for where, (a, b) in (("under", (xc, xc + hc)), ("ahead", (xc + hc, xc + hc + ahead_m))):
             a, b = max(a, 0.0), min(b, length_m)
             for tag, keep in (("body", label == body), ("all", np.ones(len(ids), bool))):
@@ -160,12 +163,54 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
                 t = solid_in_groove(xyz[keep], rad[keep], geo, b, slice_m=b - a, top_m=top, from_m=a)
                 row[f"solid_fraction_{tag}_{where}_1"] = float(t["solid_points"].sum() / t["points"].sum())
         rows.append(row)
-    return pd.DataFrame(rows)
+    d = pd.DataFrame(rows)
+    steps, f = ts["step"].to_numpy(), ts["force_normal_N"].to_numpy(float)
+    edges = d["step"].to_numpy()
+    before, after = [], []
+    for i, s0 in enumerate(edges):
+        prev = (steps > edges[i - 1]) & (steps <= s0) if i else np.zeros(len(steps), bool)
+        nxt = (steps >= s0) & (steps < edges[i + 1]) if i + 1 < len(edges) else steps >= s0
+        before.append(float(f[prev].mean()) if prev.any() else np.nan)
+        after.append(float(f[nxt].mean()) if nxt.any() else np.nan)
+    d.insert(2, "force_normal_N_before", before)
+    d.insert(3, "force_normal_N_after", after)
+    return d
+
+
+def within_run_permutation(groups: list[tuple[np.ndarray, np.ndarray]], max_exact: int = 10**7,
+                           draws: int = 200_000, seed: int = 43) -> tuple[float, float]:
+    """The mean over runs of each run's own Spearman rho (fill against F_n over its windows) and its two-sided p under
+    the null that within each run F_n is unrelated to the fill: every run's F_n permuted over its windows on its own
+    (all orders when their product is at most ``max_exact``, else ``draws`` random ones). Overlapping windows and a
+    trend of F_n along the cut common to the runs are allowed for: only the order within each run is exchanged."""
+    import itertools
+
+    from scipy.stats import spearmanr
+
+    def rho(x, y):
+        return float(spearmanr(x, y)[0])
+
+    obs = float(np.mean([rho(x, y) for x, y in groups]))
+    per_run = [np.array([rho(x, np.asarray(perm)) for perm in itertools.permutations(y)]) for x, y in groups]
+    sizes = [len(v) for v in per_run]
+    if np.prod(sizes, dtype=float) <= max_exact:
+        total = np.zeros(1)
+        for v in per_run:
+            total = np.add.outer(total, v).ravel()
+    else:
+        rng = np.random.default_rng(seed)
+        total = sum(v[rng.integers(0, len(v), draws)] for v in per_run)
+    null = total / len(groups)
+    return obs, float(np.mean(np.abs(null) >= abs(obs) - 1e-12))
 
 
 def against_forces(fill: pd.DataFrame, pair_windows: pd.DataFrame) -> pd.DataFrame:
-    """Spearman's rho (and its p) of the windows' F_n against their fill, per penetration: ``pooled`` over every run's
-    windows, ``within`` after taking each run's mean over its windows off both (the packing's level left out)."""
+    """The windows' F_n against their fill, per penetration and fill range: Spearman's rho ``pooled`` over every run's
+    windows; ``within``, after taking each run's mean over its windows off both (the run's level left out); ``two-way``,
+    after also taking each window's mean over the runs off (a trend along the cut common to the runs left out). Their
+    p values are nominal: the windows overlap (by half their patch range, more with the touched range) and runs that
+    share a packing share its fill. ``within-run`` is the mean of each run's own rho with the exact p of
+    :func:`within_run_permutation`, which needs neither independence between a run's windows nor no common trend."""
     from scipy.stats import spearmanr
 
     f = pair_windows[["case", "patch_lo_1", "force_normal_N_mean_steady"]]
@@ -173,15 +218,23 @@ def against_forces(fill: pd.DataFrame, pair_windows: pd.DataFrame) -> pd.DataFra
     missing = sorted(set(fill["case"]) - set(m["case"]))
     if missing:
         raise SystemExit(f"--pair-windows has no windows of {', '.join(missing)} (fix: pass the runs' pair windows)")
+    fn = "force_normal_N_mean_steady"
     rows = []
     for pen, g in m.groupby("penetration_mm"):
         for metric in (f"solid_fraction_{tag}_1" for tag in RANGES):
-            for how in ("pooled", "within"):
-                x, y = g[metric], g["force_normal_N_mean_steady"]
-                if how == "within":
-                    x = x - g.groupby("case")[metric].transform("mean")
-                    y = y - g.groupby("case")["force_normal_N_mean_steady"].transform("mean")
-                rho, p = spearmanr(x, y)
+            for how in ("pooled", "within", "two-way", "within-run"):
+                x, y = g[metric], g[fn]
+                if how == "within-run":
+                    groups = [(h[metric].to_numpy(), h[fn].to_numpy()) for _, h in g.groupby("case")]
+                    rho, p = within_run_permutation(groups)
+                else:
+                    if how in ("within", "two-way"):
+                        x = x - g.groupby("case")[metric].transform("mean")
+                        y = y - g.groupby("case")[fn].transform("mean")
+                    if how == "two-way":
+                        x = x - x.groupby(g["patch_lo_1"]).transform("mean")
+                        y = y - y.groupby(g["patch_lo_1"]).transform("mean")
+                    rho, p = spearmanr(x, y)
                 rows.append({"penetration_mm": pen, "fill": metric, "how": how, "runs": g["case"].nunique(),
                              "windows": len(g), "spearman_rho_1": rho, "p_1": p})
     return pd.DataFrame(rows)

@@ -127,13 +127,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _compare():
-    import importlib.util
+    from deckgen.scriptload import load_script
 
-    path = Path(__file__).resolve().parent / "compare.py"
-    spec = importlib.util.spec_from_file_location("shell_held_compare", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script(Path(__file__).resolve().parent / "compare.py", "shell_held_compare")
 
 
 if __name__ == "__main__":

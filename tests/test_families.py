@@ -2016,3 +2016,15 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert rep.loc[404, ["coarse r0.3", "coarse/coarse r0.3"]].tolist() == pytest.approx([1.905, 0.267], abs=1e-3)
     assert s4.loc["coarse r0.3", "log sd between packings"] > 3 * s4.loc["coarse r0.3", "log s.e. within runs (rms)"]
     assert (rep["coarse/coarse r0.3"] < 0.3).all() and s4.loc["coarse/coarse r0.3", "95% high"] < 0.41
+    # packing 505 (session 43, add_packing.py; no r 0.3 mm pair): the band x2.12 in the case window, from its deep cut
+    # rising (the shallow cut's case window is its highest); over five packings the case-window point estimates all lie
+    # above 1, the earlier windows' geometric means do not
+    w = mod.grain_pair_windows()
+    assert w.loc["lin_red_s100_p1p9_k505_unrel_band"].tolist() == pytest.approx([75.179, 53.662, 81.311, 96.184], abs=1e-3)
+    assert w.loc["lin_red_s100_p7p6_k505_unrel_band"].tolist() == pytest.approx([56.365, 84.166, 176.934, 203.731],
+                                                                                abs=1e-3)
+    assert r.loc["_k505_unrel_band"].tolist() == pytest.approx([0.750, 1.568, 2.176, 2.118], abs=1e-3)
+    bands = ["_unrel_band", "_k202_unrel_band", "_k303_unrel_band", "_k404_unrel_band", "_k505_unrel_band"]
+    assert (r.loc[bands, 0.4] > 1).all()
+    gm = np.exp(np.log(r.loc[bands]).mean())
+    assert gm.tolist() == pytest.approx([0.983, 0.950, 1.064, 1.851], abs=1e-3)

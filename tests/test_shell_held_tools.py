@@ -346,3 +346,29 @@ def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
     m = (ts["step"] > 21000) & (ts["step"] <= 28000)
     assert d["force_normal_N_before"].iloc[4] == pytest.approx(ts.loc[m, "force_normal_N"].mean())
     assert d["force_normal_N_after"].iloc[3] == pytest.approx(d["force_normal_N_before"].iloc[4], abs=1.0)  # 1 row apart
+
+
+def test_recorded_band_windows_rank_with_the_groove_fill():
+    """docs/families_runs/shell_held/groove_fill_windows.csv (groove_fill.py on the rendered packings, session 43)
+    against the recorded pair windows: the band's shallow cut's F_n ranks with the fill over the rock its patch
+    touches within each of the five runs (exact permutation p 0.0009), packing 505's window order was the fill's
+    (predicted before its run reached a window); the deep cut's does not."""
+    mod = load_script(HELD / "groove_fill.py")
+    fill = pd.read_csv(HELD / "groove_fill_windows.csv")
+    windows = pd.read_csv(HELD / "linear_grain_pair_windows.csv")
+    band = fill[fill["case"].str.endswith("_band")]
+    assert sorted(set(band["packing_seed"])) == [202, 303, 404, 505, 12345] and len(band) == 40
+    a = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
+    shallow, deep = 0.95, 3.8
+    assert a.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
+        [0.800, 0.00089], abs=1e-5)
+    assert a.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.612, abs=1e-3)
+    assert a.loc[(shallow, "solid_fraction_centre_1", "within-run"), "spearman_rho_1"] == 0.0
+    assert abs(a.loc[(deep, "solid_fraction_touched_1", "within-run"), "spearman_rho_1"]) < 0.25
+    # packing 505: its four windows' F_n in the order of both fills (0.4 > 0.3 > 0.1 > 0.2)
+    f5 = band[band["case"] == "lin_red_s100_p1p9_k505_unrel_band"].set_index("patch_lo_1")
+    w5 = windows[windows["case"] == "lin_red_s100_p1p9_k505_unrel_band"].set_index("patch_lo_1")
+    order = [0.4, 0.3, 0.1, 0.2]
+    for col in ("solid_fraction_touched_1", "solid_fraction_front_1"):
+        assert f5[col].sort_values(ascending=False).index.tolist() == order
+    assert w5["force_normal_N_mean_steady"].sort_values(ascending=False).index.tolist() == order

@@ -17,7 +17,8 @@ the cut and its coarse reference (``linear_unrel_band``, ``linear_unrel_s016``),
 within the run (``window_table``; ``pair_window_ratio_errors``); session 41 the band pair, its coarse reference and
 the r 0.3 mm shell pair on packings 202 and 303 (``packing_replicates``, ``packing_spread``); session 42 the same
 three pairs on packing 404, added to the recorded reports and CSVs by ``add_packing.py`` (the earlier run folders are
-gone), and ``piece_timeline.py``, when a piece breaks off a run against its F_n.
+gone), and ``piece_timeline.py``, when a piece breaks off a run against its F_n; session 43 the band pair and its coarse
+reference on packing 505 (``add_packing.py``) and ``groove_fill.py``, the rock the disc's groove holds along the cut.
 
     python docs/families_runs/shell_held/compare.py
     python docs/families_runs/shell_held/compare.py --windows docs/families_runs/shell_held/linear_windows.csv <parsed>...
@@ -79,8 +80,8 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: them over the windows, :func:`pair_window_ratios`, not over their case window), and the coarse pair on packing 202
 #: as well (no fine pair; its runs are in the same report); 33 mm free: session 40, the band pair and its coarse
 #: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell), on
-#: packings 12345 and 202 (one report per grain size holds both), 303 (session 41) and 404 (session 42; not a family
-#: packing: add_packing.py)
+#: packings 12345 and 202 (one report per grain size holds both), 303 (session 41), 404 (session 42; not a family
+#: packing: add_packing.py) and 505 (session 43, no r 0.3 mm pair)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -95,7 +96,9 @@ GRAIN_PAIRS = {
     (33, "free", 303): {"coarse": ("_k303_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k303_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 404): {"coarse": ("_k404_unrel_s016", HERE / "linear_unrel_s016"),
-                        "band": ("_k404_unrel_band", HERE / "linear_unrel_band")}}
+                        "band": ("_k404_unrel_band", HERE / "linear_unrel_band")},
+    (33, "free", 505): {"coarse": ("_k505_unrel_s016", HERE / "linear_unrel_s016"),
+                        "band": ("_k505_unrel_band", HERE / "linear_unrel_band")}}
 #: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
 #: 35, 41 and 42), per :data:`GRAIN_PAIRS` key: the shell-radius reference of :func:`packing_replicates`
 SHELL03_TAILS = {(33, "free", 12345): "_unrel", (33, "free", 202): "_k202_unrel", (33, "free", 303): "_k303_unrel",

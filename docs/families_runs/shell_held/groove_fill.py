@@ -222,7 +222,8 @@ def against_forces(fill: pd.DataFrame, pair_windows: pd.DataFrame) -> pd.DataFra
     rows = []
     for pen, g in m.groupby("penetration_mm"):
         for metric in (f"solid_fraction_{tag}_1" for tag in RANGES):
-            for how in ("pooled", "within", "two-way", "within-run"):
+            hows = ("pooled", "within", "two-way", "within-run") if g["case"].nunique() > 1 else ("within-run",)
+            for how in hows:
                 x, y = g[metric], g[fn]
                 if how == "within-run":
                     groups = [(h[metric].to_numpy(), h[fn].to_numpy()) for _, h in g.groupby("case")]

@@ -1,7 +1,7 @@
 """How much rock does the disc's groove hold along the cut, in the packing as rendered (session 43)?
 
-A linear cut at penetration p removes the groove: the disc's cross-section profile (``deckgen.deck.cutter_profile``)
-below the block's nominal top, swept along x. With p 0.95 mm (the reduced p 1.9 mm cut) and grains of radius
+A linear cut at penetration p removes the groove: the disc's cross-section profile (``deckgen.deck.cutter_profile``,
+its tip p below the block's nominal top) up to the highest grain top, swept along x. With p 0.95 mm (the reduced p 1.9 mm cut) and grains of radius
 0.35-0.5 mm (the band) the top layer's roughness is a sizeable part of the groove, so the rock the disc meets may vary
 along the cut from the packing alone. This script measures it before any cutting: the grain volume inside the groove
 per slice of x (sample points on a regular grid in the groove, each inside a grain or not), as the solid fraction of

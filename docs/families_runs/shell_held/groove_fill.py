@@ -5,8 +5,8 @@ its tip p below the block's nominal top) up to the highest grain top, swept alon
 0.35-0.5 mm (the band) the top layer's roughness is a sizeable part of the groove, so the rock the disc meets may vary
 along the cut from the packing alone. This script measures it before any cutting: the grain volume inside the groove
 per slice of x (sample points on a regular grid in the groove, each inside a grain or not), as the solid fraction of
-the groove, and per window of the cut (``compare.PATCH_WINDOWS``: the contact-patch centre between ``lo`` and
-``lo + 0.2`` of the block length) over three ranges of x (:data:`RANGES`): the rock the patch touches in the window
+the groove, and per window of the cut (``compare.PATCH_WINDOWS``, loaded from there: the contact-patch centre
+between ``lo`` and ``lo + 0.2`` of the block length) over three ranges of x (:data:`RANGES`): the rock the patch touches in the window
 (the centre's range extended by half the patch chord either side), the centre's range, and the rock the disc's
 leading edge enters in the window.
 
@@ -27,6 +27,7 @@ at each dump the groove's fill under the disc and just ahead of it, by the body 
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
 from pathlib import Path
@@ -39,14 +40,12 @@ STEP_M = 4e-5
 #: nearest grain centres tested per sample point (a point may lie in a large grain whose centre is farther than some
 #: small grains' centres; session 43's review found no miss with 8 on the band's 0.35 / 1.0 mm grains, 16 for margin)
 NEAREST = 16
-#: windows of the cut, as in compare.window_table: the contact-patch centre from lo to lo + 0.2 of the block length
-WINDOWS = (0.1, 0.2, 0.3, 0.4)
 
 
 def groove_geometry(case) -> dict[str, float | np.ndarray]:
-    """The groove's cross-section (profile polygon in (depth below the disc centre, y)), the disc centre height and
-    radius [m] of a validated linear cutting case."""
-    from deckgen.deck import cutter_profile
+    """The groove's cross-section (profile polygon in (depth below the disc centre, y)), the disc centre height (the
+    deck's, ``deck.cutter_path``) and radius [m] of a validated linear cutting case."""
+    from deckgen.deck import cutter_path, cutter_profile
 
     if case.kinematics.mode != "linear":
         raise SystemExit(f"{case.name}: kinematics.mode is {case.kinematics.mode!r}; the groove is a linear cut's")
@@ -55,8 +54,7 @@ def groove_geometry(case) -> dict[str, float | np.ndarray]:
                          "profile of an untilted ccs_disc or v_disc swept along x")
     prof = cutter_profile(case)
     radius = float(prof[:, 0].max())
-    zc = case.specimen.height_mm * 1e-3 - case.kinematics.penetration_mm * 1e-3 + radius
-    return {"profile": prof, "radius_m": radius, "centre_z_m": zc}
+    return {"profile": prof, "radius_m": radius, "centre_z_m": cutter_path(case, radius)["zc0"]}
 
 
 def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, slice_m: float = 1e-4,
@@ -107,13 +105,21 @@ def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, sl
 RANGES = {"touched": (-0.5, 0.5), "centre": (0.0, 0.0), "front": (0.5, 0.5)}
 
 
+@functools.cache
+def _patch_windows() -> tuple[float, ...]:
+    """compare.py's PATCH_WINDOWS (the windows' contact-patch starts), loaded once."""
+    from deckgen.scriptload import load_script
+
+    return tuple(load_script(Path(__file__).resolve().parent / "compare.py", "shell_held_compare").PATCH_WINDOWS)
+
+
 def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> pd.DataFrame:
     """Per window (patch centre from lo to lo + 0.2 of the block), the groove's solid fraction and grain volume over
     each range of :data:`RANGES` (from lo * L + a * h to (lo + 0.2) * L + b * h), each slice weighted by the part of
     it inside the range."""
     x0, x1 = slices["x_lo_m"].to_numpy(), slices["x_hi_m"].to_numpy()
     rows = []
-    for lo in WINDOWS:
+    for lo in _patch_windows():
         row = {"patch_lo_1": lo}
         for tag, (pa, pb) in RANGES.items():
             a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
@@ -132,7 +138,8 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
     ``deckgen.chips.bond_components``) and by every rock grain (``all``; all minus body is the detached grains'). The
     groove's top is the rendered packing's highest grain top. With the step's patch centre (fraction of the block) and
     F_n averaged over the series rows since the dump before (``force_normal_N_before``, NaN at the first dump) and up to
-    the dump after (``force_normal_N_after``; the last dump's up to the series' end)."""
+    the dump after (``force_normal_N_after``; the last dump's up to the series' end); one row per dump, the case named
+    in ``case``."""
     from deckgen.chips import bond_components, initial_bonds
     from deckgen.families import half_chord_mm
     from deckgen.parse.dump import iter_frames
@@ -153,7 +160,7 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
         pairs = broken.loc[broken["step"] <= fr.timestep, ["id1", "id2"]].to_numpy(np.int64)
         label, _, body = bond_components(bonds, pairs, ids)
         xc = float(np.interp(fr.timestep, ts["step"], ts["cutter_x_m"]))
-        row = {"step": fr.timestep, "patch_centre_1": (xc + hc / 2) / length_m}
+        row = {"case": case.name, "step": fr.timestep, "patch_centre_1": (xc + hc / 2) / length_m}
         for where, (a, b) in (("under", (xc, xc + hc)), ("ahead", (xc + hc, xc + hc + ahead_m))):
             a, b = max(a, 0.0), min(b, length_m)
             for tag, keep in (("body", label == body), ("all", np.ones(len(ids), bool))):
@@ -172,8 +179,8 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
         nxt = (steps >= s0) & (steps < edges[i + 1]) if i + 1 < len(edges) else steps >= s0
         before.append(float(f[prev].mean()) if prev.any() else np.nan)
         after.append(float(f[nxt].mean()) if nxt.any() else np.nan)
-    d.insert(2, "force_normal_N_before", before)
-    d.insert(3, "force_normal_N_after", after)
+    d.insert(3, "force_normal_N_before", before)
+    d.insert(4, "force_normal_N_after", after)
     return d
 
 
@@ -276,7 +283,6 @@ def main(argv: list[str] | None = None) -> int:
                     raise SystemExit(f"{need}: missing (fix: deckgen render/run into X/run, deckgen parse X/run --out "
                                      "X/parsed)")
             d = body_fill_at_dumps(x / "run", x / "parsed", a.ahead_mm * 1e-3)
-            d.insert(0, "case", json.loads((x / "run" / "spec.json").read_text())["case"]["name"])
             tables.append(d)
             with pd.option_context("display.width", 250, "display.max_columns", 20):
                 print(d.drop(columns="case").round(3).to_string(index=False))

@@ -176,15 +176,19 @@ def _flat(path: Path) -> dict:
     return dict(walk(yaml.safe_load(path.read_text())))
 
 
-def test_session42_and_43_cases_change_only_the_packing_seed_or_the_dumps():
+def test_session42_to_44_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    for seed in (404, 505):
+    tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),  # 505: no r 0.3 mm
+             606: ("_unrel_band",)}  # 606 (session 44): the band pair only
+    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k606*.yaml")) == [
+        "lin_red_s100_p1p9_k606_unrel_band.yaml", "lin_red_s100_p7p6_k606_unrel_band.yaml"]
+    for seed in (404, 505, 606):
         for p in ("1p9", "7p6"):
-            for tail in ("_unrel", "_unrel_band", "_unrel_s016")[seed == 505:]:  # 505: no r 0.3 mm pair
+            for tail in tails[seed]:
                 a = _flat(rec / f"lin_red_s100_p{p}_k{seed}{tail}.yaml")
                 b = _flat(rec / f"lin_red_s100_p{p}_k303{tail}.yaml")
                 diff = {k for k in a.keys() | b.keys() if a.get(k) != b.get(k)}
-                dumps = {("outputs", "dump_every")} if (seed, p, tail) == (505, "1p9", "_unrel_band") else set()
+                dumps = {("outputs", "dump_every")} if seed > 404 and (p, tail) == ("1p9", "_unrel_band") else set()
                 assert diff == {("name",), ("packing", "seed")} | dumps
                 assert a[("packing", "seed")] == seed and a[("name",)] == f"lin_red_s100_p{p}_k{seed}{tail}"
     a, b = _flat(rec / "lin_red_s100_p1p9_k303_unrel_dumps.yaml"), _flat(rec / "lin_red_s100_p1p9_k303_unrel.yaml")
@@ -239,6 +243,21 @@ def test_the_404_r03_pair_splits_a_side_off_its_deep_cut_at_the_case_windows_end
     assert end["largest_piece_grains"] == 421 and end["piece_min_y_mm"] > 4 and end["piece_max_y_mm"] > 16.5
 
 
+def _boolean_model(mod, case, seed: int = 7):
+    """Spheres of radius 0.05 mm at uniformly random centres (overlaps allowed) filling half of space on average, over
+    the reference cut's groove (16 mm long, tip 6.5 mm, block top 8 mm) and a sphere's margin on every side, the top
+    included. Returns (groove geometry, centres, radius, (box low, box high), the generator)."""
+    geo = mod.groove_geometry(case)
+    rad = 5e-5
+    n = np.log(2.0) / (4.0 / 3.0 * np.pi * rad**3)  # centres per m^3 for a fraction of 0.5
+    # the groove's half width at the top, bounded above: the tip arc's (0.26 mm; v_disc, tip radius 0.3 mm) plus the
+    # flank's run over the whole 1.5 mm (the true one, 1.04 mm, is over 1.35 mm)
+    half_w = 0.26e-3 + 1.5e-3 * np.tan(np.radians(case.cutter.edge_angle_deg / 2))
+    lo, hi = np.array([-rad, -half_w - rad, 6.5e-3 - rad]), np.array([16e-3 + rad, half_w + rad, 8e-3 + rad])
+    rng = np.random.default_rng(seed)
+    return geo, rng.uniform(lo, hi, size=(rng.poisson(n * np.prod(hi - lo)), 3)), rad, (lo, hi), rng
+
+
 def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
     """groove_fill.py on the reference cut's case with its grains replaced by spheres of radius 0.05 mm at uniformly
     random centres, overlaps allowed (a Boolean model): the solid fraction of any region is 1 - exp(-n V), n the
@@ -250,17 +269,8 @@ def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
     assert len(x) == len(r) == 542 and 0.5e-3 < r.min() < r.max() < 0.9e-3 and r.max() / r.min() <= 0.9 / 0.6 + 1e-9
     from deckgen.chips import groove_area
 
-    geo = mod.groove_geometry(case)
+    geo, pts, rad, (lo, hi), rng = _boolean_model(mod, case)
     assert geo["centre_z_m"] - geo["radius_m"] == pytest.approx(8e-3 - 1.5e-3)  # the tip 1.5 mm below the top
-    rad = 5e-5
-    n = np.log(2.0) / (4.0 / 3.0 * np.pi * rad**3)  # centres per m^3 for a fraction of 0.5
-    # the groove's half width at the top, bounded above: the tip arc's (0.26 mm; v_disc, tip radius 0.3 mm) plus the
-    # flank's run over the whole 1.5 mm (the true one, 1.04 mm, is over 1.35 mm)
-    half_w = 0.26e-3 + 1.5e-3 * np.tan(np.radians(case.cutter.edge_angle_deg / 2))
-    # centres over the groove and a sphere's margin on every side, the top included: the groove is bulk everywhere
-    lo, hi = np.array([-rad, -half_w - rad, 6.5e-3 - rad]), np.array([16e-3 + rad, half_w + rad, 8e-3 + rad])
-    rng = np.random.default_rng(7)
-    pts = rng.uniform(lo, hi, size=(rng.poisson(n * np.prod(hi - lo)), 3))
     t = mod.solid_in_groove(pts, np.full(len(pts), rad), geo, 16e-3, slice_m=2e-3, step_m=2e-5, top_m=8e-3)
     assert len(t) == 8 and t["groove_area_m2"].nunique() == 1
     # the sampled groove is the disc's cross-section below the top (deckgen.chips.groove_area of the profile)
@@ -283,6 +293,31 @@ def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
     t2 = mod.solid_in_groove(pts, np.full(len(pts), rad), geo, 16e-3, slice_m=2e-3, step_m=2e-5)
     assert t2["groove_area_m2"].iloc[0] > t["groove_area_m2"].iloc[0]
     assert t2["solid_points"].sum() / t2["points"].sum() < 0.5 - 0.005
+
+
+def test_groove_fill_layers_above_the_tip_of_random_spheres():
+    """groove_fill.layer_fill on the Boolean model of the test above: every layer below the block's top is filled to
+    1 - exp(-n V) = 0.5, the layer reaching up to the highest sphere top less, and the layers' points add up to the
+    whole groove's window by window, their fill to window_fill's (the layers share one grid)."""
+    mod = load_script(HELD / "groove_fill.py")
+    case, _, _ = mod.load(CUT)
+    geo, pts, rad, _, _ = _boolean_model(mod, case, seed=11)
+    r = np.full(len(pts), rad)
+    L, hc = 16e-3, 1.5e-3
+    lay = mod.layer_fill(pts, r, geo, L, hc, heights_mm=(0.3, 0.7, 1.2), slice_m=5e-4)
+    assert lay["layer_lo_mm"].tolist()[:4] == [0.0, 0.3, 0.7, 1.2] and np.isnan(lay["layer_hi_mm"].iloc[3])
+    below = lay[lay["layer_hi_mm"].notna()]
+    # one layer of one window holds ~0.3-1 mm^3 of the groove: its fill scatters by ~0.01-0.02 about 0.5
+    assert below["solid_fraction_1"].to_numpy() == pytest.approx(0.5, abs=0.05)
+    assert below["solid_fraction_1"].mean() == pytest.approx(0.5, abs=0.015)
+    top = lay[lay["layer_hi_mm"].isna()]
+    assert (top["solid_fraction_1"] < 0.5).all()  # up to the highest sphere top (8.1 mm), thinning above 8 mm
+    whole = mod.window_fill(mod.solid_in_groove(pts, r, geo, L, 5e-4), L, hc).set_index("patch_lo_1")
+    for lo, g in lay.groupby("patch_lo_1"):
+        pooled = (g["solid_fraction_1"] * g["points"]).sum() / g["points"].sum()
+        assert pooled == pytest.approx(whole.loc[lo, "solid_fraction_touched_1"], rel=1e-12)
+    with pytest.raises(KeyError):
+        mod.layer_fill(pts, r, geo, L, hc, where="nowhere")
 
 
 def test_groove_fill_windows_weight_slices_by_overlap_and_correlate():

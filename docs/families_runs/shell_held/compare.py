@@ -81,7 +81,7 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: as well (no fine pair; its runs are in the same report); 33 mm free: session 40, the band pair and its coarse
 #: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell), on
 #: packings 12345 and 202 (one report per grain size holds both), 303 (session 41), 404 (session 42; not a family
-#: packing: add_packing.py) and 505 (session 43, no r 0.3 mm pair)
+#: packing: add_packing.py), 505 (session 43, no r 0.3 mm pair) and 606 (session 44, the band pair only)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -98,7 +98,8 @@ GRAIN_PAIRS = {
     (33, "free", 404): {"coarse": ("_k404_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k404_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 505): {"coarse": ("_k505_unrel_s016", HERE / "linear_unrel_s016"),
-                        "band": ("_k505_unrel_band", HERE / "linear_unrel_band")}}
+                        "band": ("_k505_unrel_band", HERE / "linear_unrel_band")},
+    (33, "free", 606): {"band": ("_k606_unrel_band", HERE / "linear_unrel_band")}}
 #: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
 #: 35, 41 and 42), per :data:`GRAIN_PAIRS` key: the shell-radius reference of :func:`packing_replicates`
 SHELL03_TAILS = {(33, "free", 12345): "_unrel", (33, "free", 202): "_k202_unrel", (33, "free", 303): "_k303_unrel",
@@ -681,8 +682,9 @@ def pair_window_ratio_errors(windows: pd.DataFrame | None = None) -> pd.DataFram
 
 def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4) -> pd.DataFrame:
     """The band pair and its coarse reference on every packing of :data:`GRAIN_PAIRS` at this block width and sides
-    that has both in the pair windows: per packing (index) F_n p 7.6 / 1.9 mm over ``window`` (the contact-patch start;
-    0.4 is the case window) for ``band`` and ``coarse`` with their within-run standard errors
+    that has the band pair in the pair windows: per packing (index) F_n p 7.6 / 1.9 mm over ``window`` (the
+    contact-patch start; 0.4 is the case window) for ``band`` and ``coarse`` (NaN where the coarse pair was not run)
+    with their within-run standard errors
     (:func:`pair_window_ratio_errors`), ``band/coarse``, the band's ratio over its same-packing reference's, and (33 mm
     block, where its pair windows exist, else NaN) ``coarse r0.3`` with its error, the coarse pair with the r 0.3 mm
     shell (:data:`SHELL03_TAILS`), and ``coarse/coarse r0.3``, the shell radius's effect on the ratio."""
@@ -691,14 +693,14 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
     rows = []
     for key, sizes in GRAIN_PAIRS.items():
         packing = key[2]
-        if key[:2] != (width, sides) or not {"band", "coarse"} <= set(sizes):
-            continue
-        tails = {size: sizes[size][0] for size in ("band", "coarse")}
-        if not all(t in ratios.index for t in tails.values()):
-            continue  # not run (yet)
+        if key[:2] != (width, sides) or "band" not in sizes or sizes["band"][0] not in ratios.index:
+            continue  # no band pair here, or not run (yet)
         row = {"packing": packing}
-        for size, t in tails.items():
-            row[size], row[f"{size} s.e."] = ratios.loc[t, window], errors.loc[t, window]
+        for size in ("band", "coarse"):
+            t = sizes[size][0] if size in sizes else None
+            has = t in ratios.index  # packing 606 (session 44): the band pair only
+            row[size] = ratios.loc[t, window] if has else float("nan")
+            row[f"{size} s.e."] = errors.loc[t, window] if has else float("nan")
         row["band/coarse"] = row["band"] / row["coarse"]
         t03 = SHELL03_TAILS.get(key)
         has03 = t03 in ratios.index
@@ -731,7 +733,7 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
     rel["coarse/coarse r0.3"] = np.hypot(rel["coarse"], rel["coarse r0.3"])
     rows = []
     for col in ("band", "coarse", "band/coarse", "coarse r0.3", "coarse/coarse r0.3"):
-        ok = t[col].notna()  # the r 0.3 mm shell pair was not run on every packing (505, session 43)
+        ok = t[col].notna()  # no r 0.3 mm shell pair on 505 (session 43), no coarse pair on 606 (session 44)
         if ok.sum() < 2:
             continue
         lg = np.log(t.loc[ok, col].to_numpy(dtype=float))

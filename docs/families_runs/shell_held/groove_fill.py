@@ -11,7 +11,7 @@ between ``lo`` and ``lo + 0.2`` of the block length) over three ranges of x (:da
 leading edge enters in the window.
 
     python docs/families_runs/shell_held/groove_fill.py X [X ...] [--slice-mm 0.1] [--out CSV] [--windows-out CSV] \
-        [--pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv]
+        [--pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv] [--layers-out CSV]
     python docs/families_runs/shell_held/groove_fill.py --dumps X [X ...] [--ahead-mm 2] [--out CSV]
 
 ``X`` is a rendered run folder (``spec.json`` and ``specimen.data``; ``deckgen render`` alone is enough, no run
@@ -127,6 +127,38 @@ def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> p
             row[f"solid_fraction_{tag}_1"] = float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
             row[f"grain_volume_{tag}_mm3"] = float((w * slices["grain_volume_m3"]).sum() * 1e9)
         rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_chord_m: float,
+               heights_mm: tuple[float, ...] = (0.2, 0.4, 0.6, 0.7, 0.8), where: str = "touched",
+               slice_m: float = 1e-4) -> pd.DataFrame:
+    """Per window (:func:`window_fill`'s, over the range ``where`` of :data:`RANGES`), the groove's solid fraction in
+    layers above the disc's tip: from the tip to ``heights_mm[0]`` above it, between consecutive heights, and from the
+    last height to the groove's top (the highest grain top; ``layer_hi_mm`` NaN). Each layer's fraction is the
+    difference of the groove's solid and total sample points below its two bounds (:func:`solid_in_groove` with
+    ``top_m``), so the layers share one grid and their points add up to the whole groove's (session 44: whether the
+    rock standing across the tip plane carries the link of the windows' F_n with the fill)."""
+    tip = geo["centre_z_m"] - geo["radius_m"]
+    pa, pb = RANGES[where]
+    cum = []  # per top: (solid points, points) per window
+    for h in (*heights_mm, None):
+        t = solid_in_groove(x, r, geo, length_m, slice_m, top_m=None if h is None else tip + h * 1e-3)
+        x0, x1 = t["x_lo_m"].to_numpy(), t["x_hi_m"].to_numpy()
+        per = []
+        for lo in _patch_windows():
+            a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
+            w = np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
+            per.append(((w * t["solid_points"]).sum(), (w * t["points"]).sum()))
+        cum.append(np.array(per))
+    rows = []
+    bounds = (0.0, *heights_mm, float("nan"))
+    for i, lo in enumerate(_patch_windows()):
+        for k in range(len(cum)):
+            solid = cum[k][i, 0] - (cum[k - 1][i, 0] if k else 0.0)
+            pts = cum[k][i, 1] - (cum[k - 1][i, 1] if k else 0.0)
+            rows.append({"patch_lo_1": lo, "layer_lo_mm": bounds[k], "layer_hi_mm": bounds[k + 1],
+                         "points": pts, "solid_fraction_1": solid / pts if pts > 0 else float("nan")})
     return pd.DataFrame(rows)
 
 
@@ -274,6 +306,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="each argument is a folder X with X/run (run) and X/parsed (deckgen parse): the fill under and "
                          "ahead of the disc at each dump (body_fill_at_dumps) instead")
     ap.add_argument("--ahead-mm", type=float, default=2.0, help="--dumps: how far beyond the disc's leading edge")
+    ap.add_argument("--layers-out", type=Path,
+                    help="per window and layer above the tip (layer_fill, touched range; heights 0.2/0.4/0.6/0.7/0.8 mm)")
     a = ap.parse_args(argv)
     if a.dumps:
         tables = []
@@ -289,7 +323,7 @@ def main(argv: list[str] | None = None) -> int:
         if a.out:
             pd.concat(tables).to_csv(a.out, index=False, float_format="%.6g")
         return 0
-    all_slices, all_windows = [], []
+    all_slices, all_windows, all_layers = [], [], []
     for run in a.runs:
         for need in ("spec.json", "specimen.data"):
             if not (run / need).is_file():
@@ -306,6 +340,12 @@ def main(argv: list[str] | None = None) -> int:
             t.insert(0, "case", case.name)
         all_slices.append(slices)
         all_windows.append(win)
+        if a.layers_out:
+            lay = layer_fill(x, r, geo, length_m, hc, slice_m=a.slice_mm * 1e-3)
+            for col, v in (("penetration_mm", case.kinematics.penetration_mm), ("packing_seed", case.packing.seed),
+                           ("case", case.name)):
+                lay.insert(0, col, v)
+            all_layers.append(lay)
         print(f"== {case.name} (packing {case.packing.seed}, {len(x)} rock grains): groove solid fraction "
               f"{slices['solid_points'].sum() / slices['points'].sum():.4f} over the block")
         print(win.drop(columns=["case", "packing_seed", "penetration_mm"]).to_string(
@@ -314,6 +354,8 @@ def main(argv: list[str] | None = None) -> int:
         pd.concat(all_slices).to_csv(a.out, index=False, float_format="%.6g")
     if a.windows_out:
         pd.concat(all_windows).to_csv(a.windows_out, index=False, float_format="%.6g")
+    if a.layers_out:
+        pd.concat(all_layers).to_csv(a.layers_out, index=False, float_format="%.6g")
     if a.pair_windows:
         print("== F_n of each window against the groove's fill (Spearman)")
         print(against_forces(pd.concat(all_windows), pd.read_csv(a.pair_windows)).to_string(

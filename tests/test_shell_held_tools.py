@@ -297,26 +297,43 @@ def test_groove_fill_of_random_spheres_is_the_boolean_model_fraction():
 
 def test_groove_fill_layers_above_the_tip_of_random_spheres():
     """groove_fill.layer_fill on the Boolean model of the test above: every layer below the block's top is filled to
-    1 - exp(-n V) = 0.5, the layer reaching up to the highest sphere top less, and the layers' points add up to the
-    whole groove's window by window, their fill to window_fill's (the layers share one grid)."""
+    1 - exp(-n V) = 0.5; each layer's share of a window's points is its share of the groove's cross-section
+    (chips.groove_area between its bounds); the layers add up to window_fill's whole groove; with the spheres' centres
+    only up to 0.4 mm above the tip the layers above that hold next to nothing. Heights off the grid, out of order or
+    above the top are refused."""
+    from deckgen.chips import groove_area
+
     mod = load_script(HELD / "groove_fill.py")
     case, _, _ = mod.load(CUT)
     geo, pts, rad, _, _ = _boolean_model(mod, case, seed=11)
     r = np.full(len(pts), rad)
     L, hc = 16e-3, 1.5e-3
-    lay = mod.layer_fill(pts, r, geo, L, hc, heights_mm=(0.3, 0.7, 1.2), slice_m=5e-4)
-    assert lay["layer_lo_mm"].tolist()[:4] == [0.0, 0.3, 0.7, 1.2] and np.isnan(lay["layer_hi_mm"].iloc[3])
+    tip = geo["centre_z_m"] - geo["radius_m"]
+    lay = mod.layer_fill(pts, r, geo, L, hc, heights_mm=(0.2, 0.4, 0.8), slice_m=5e-4)
+    assert lay["layer_lo_mm"].tolist()[:4] == [0.0, 0.2, 0.4, 0.8] and np.isnan(lay["layer_hi_mm"].iloc[3])
     below = lay[lay["layer_hi_mm"].notna()]
-    # one layer of one window holds ~0.3-1 mm^3 of the groove: its fill scatters by ~0.01-0.02 about 0.5
-    assert below["solid_fraction_1"].to_numpy() == pytest.approx(0.5, abs=0.05)
-    assert below["solid_fraction_1"].mean() == pytest.approx(0.5, abs=0.015)
-    top = lay[lay["layer_hi_mm"].isna()]
-    assert (top["solid_fraction_1"] < 0.5).all()  # up to the highest sphere top (8.1 mm), thinning above 8 mm
+    # one layer of one window holds 0.6-3.7 mm^3 of the groove: its fill scatters by ~0.005-0.013 about 0.5
+    assert below["solid_fraction_1"].to_numpy() == pytest.approx(0.5, abs=0.04)
+    assert below["solid_fraction_1"].mean() == pytest.approx(0.5, abs=0.01)
+    top_layer = lay[lay["layer_hi_mm"].isna()]
+    assert (top_layer["solid_fraction_1"] < 0.5).all()  # up to the highest sphere top (8.1 mm), thinning above 8 mm
+    depth_top = float((pts[:, 2] + rad).max()) - tip
+    area = [groove_area(geo["profile"], geo["radius_m"], d) for d in (0.0, 2e-4, 4e-4, 8e-4, depth_top)]
+    share = np.diff(area) / area[-1]
     whole = mod.window_fill(mod.solid_in_groove(pts, r, geo, L, 5e-4), L, hc).set_index("patch_lo_1")
     for lo, g in lay.groupby("patch_lo_1"):
+        assert (g["points"] / g["points"].sum()).to_numpy() == pytest.approx(share, rel=0.02)
         pooled = (g["solid_fraction_1"] * g["points"]).sum() / g["points"].sum()
         assert pooled == pytest.approx(whole.loc[lo, "solid_fraction_touched_1"], rel=1e-12)
-    with pytest.raises(KeyError):
+    # the spheres whose centres lie below 0.4 mm above the tip only: full below 0.35 mm, thinning to 0 at 0.45 mm
+    low = pts[:, 2] < tip + 4e-4
+    lay2 = mod.layer_fill(pts[low], r[low], geo, L, hc, heights_mm=(0.2, 0.4), slice_m=5e-4)
+    f = lay2.groupby("layer_lo_mm")["solid_fraction_1"].mean()
+    assert f[0.0] == pytest.approx(0.5, abs=0.02) and 0.45 < f[0.2] < 0.5 and f[0.4] < 0.2
+    for bad in ((0.3,), (0.4, 0.2), (2.0,)):  # 0.3 mm is 7.5 grid steps; out of order; above the top (8.1 mm)
+        with pytest.raises(ValueError, match="multiples of the grid step"):
+            mod.layer_fill(pts, r, geo, L, hc, heights_mm=bad)
+    with pytest.raises(ValueError, match="'nowhere' is not one of touched"):
         mod.layer_fill(pts, r, geo, L, hc, where="nowhere")
 
 

@@ -20,8 +20,9 @@ own ``packed.data`` would overstate the fill by ~6 %. Prints per run the windows
 with ``--pair-windows`` (the runs' recorded F_n per window, ``compare.py --pair-windows``) also the rank correlation of
 F_n with the fill per penetration (:func:`against_forces`). These correlations describe the recorded runs; the windows
 overlap and a trend along the cut shared by the runs can make a link where there is none (the ``two-way`` rows take
-it off), so they are not tests of a cause. With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead:
-at each dump the groove's fill under the disc and just ahead of it, by the body and by every grain
+it off), so they are not tests of a cause. ``--layers-out`` writes the touched range's fill per layer above the
+disc's tip (:func:`layer_fill`). With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead: at
+each dump the groove's fill under the disc and just ahead of it, by the body and by every grain
 (:func:`body_fill_at_dumps`): where the rock the disc meets next is still part of the body, loose, or gone.
 """
 from __future__ import annotations
@@ -131,19 +132,32 @@ def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> p
 
 
 def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_chord_m: float,
-               heights_mm: tuple[float, ...] = (0.2, 0.4, 0.6, 0.7, 0.8), where: str = "touched",
+               heights_mm: tuple[float, ...] = (0.2, 0.4, 0.6, 0.8), where: str = "touched",
                slice_m: float = 1e-4) -> pd.DataFrame:
     """Per window (:func:`window_fill`'s, over the range ``where`` of :data:`RANGES`), the groove's solid fraction in
     layers above the disc's tip: from the tip to ``heights_mm[0]`` above it, between consecutive heights, and from the
     last height to the groove's top (the highest grain top; ``layer_hi_mm`` NaN). Each layer's fraction is the
     difference of the groove's solid and total sample points below its two bounds (:func:`solid_in_groove` with
-    ``top_m``), so the layers share one grid and their points add up to the whole groove's (session 44: whether the
-    rock standing across the tip plane carries the link of the windows' F_n with the fill)."""
+    ``top_m``), so the layers share one grid and their points add up to the whole groove's; ``points`` is that count
+    weighted by each slice's overlap with the range (fractional). The grid's rows lie at (i + 1/2) grid steps above the
+    tip, so the heights must be whole multiples of the step (0.04 mm; no row then sits on a bound), increasing, and
+    below the groove's top (session 44: whether the rock standing across the tip plane carries the link of the
+    windows' F_n with the fill)."""
     tip = geo["centre_z_m"] - geo["radius_m"]
+    top = float((x[:, 2] + r).max())
+    if where not in RANGES:
+        raise ValueError(f"layer_fill: range {where!r} is not one of {', '.join(RANGES)}")
+    h = np.asarray(heights_mm, dtype=float) * 1e-3
+    steps = h / STEP_M
+    if (len(h) == 0 or np.any(np.abs(steps - np.round(steps)) > 1e-6) or np.any(np.diff(h) <= 0) or h[0] <= 0
+            or tip + h[-1] >= top):
+        raise ValueError(f"layer_fill: heights {tuple(heights_mm)} mm must be increasing, positive multiples of the "
+                         f"grid step {STEP_M * 1e3:g} mm and below the groove's top ({(top - tip) * 1e3:.3f} mm above "
+                         "the tip)")
     pa, pb = RANGES[where]
     cum = []  # per top: (solid points, points) per window
-    for h in (*heights_mm, None):
-        t = solid_in_groove(x, r, geo, length_m, slice_m, top_m=None if h is None else tip + h * 1e-3)
+    for top_k in (*(tip + h), None):
+        t = solid_in_groove(x, r, geo, length_m, slice_m, top_m=top_k)
         x0, x1 = t["x_lo_m"].to_numpy(), t["x_hi_m"].to_numpy()
         per = []
         for lo in _patch_windows():
@@ -158,7 +172,7 @@ def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_ch
             solid = cum[k][i, 0] - (cum[k - 1][i, 0] if k else 0.0)
             pts = cum[k][i, 1] - (cum[k - 1][i, 1] if k else 0.0)
             rows.append({"patch_lo_1": lo, "layer_lo_mm": bounds[k], "layer_hi_mm": bounds[k + 1],
-                         "points": pts, "solid_fraction_1": solid / pts if pts > 0 else float("nan")})
+                         "points": pts, "solid_fraction_1": solid / pts})
     return pd.DataFrame(rows)
 
 
@@ -307,7 +321,7 @@ def main(argv: list[str] | None = None) -> int:
                          "ahead of the disc at each dump (body_fill_at_dumps) instead")
     ap.add_argument("--ahead-mm", type=float, default=2.0, help="--dumps: how far beyond the disc's leading edge")
     ap.add_argument("--layers-out", type=Path,
-                    help="per window and layer above the tip (layer_fill, touched range; heights 0.2/0.4/0.6/0.7/0.8 mm)")
+                    help="per window and layer above the tip (layer_fill, touched range; heights 0.2/0.4/0.6/0.8 mm)")
     a = ap.parse_args(argv)
     if a.dumps:
         tables = []

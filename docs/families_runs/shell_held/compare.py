@@ -696,16 +696,16 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
         if key[:2] != (width, sides) or "band" not in sizes or sizes["band"][0] not in ratios.index:
             continue  # no band pair here, or not run (yet)
         row = {"packing": packing}
-        for size in ("band", "coarse"):
-            t = sizes[size][0] if size in sizes else None
-            has = t in ratios.index  # packing 606 (session 44): the band pair only
-            row[size] = ratios.loc[t, window] if has else float("nan")
-            row[f"{size} s.e."] = errors.loc[t, window] if has else float("nan")
+
+        def put(col: str, t: str | None) -> None:  # the pair's ratio and error, NaN where it was not run
+            has = t in ratios.index  # 606 (session 44): the band pair only; 505: no r 0.3 mm pair
+            row[col] = ratios.loc[t, window] if has else float("nan")
+            row[f"{col} s.e."] = errors.loc[t, window] if has else float("nan")
+
+        put("band", sizes["band"][0])
+        put("coarse", sizes.get("coarse", (None,))[0])
         row["band/coarse"] = row["band"] / row["coarse"]
-        t03 = SHELL03_TAILS.get(key)
-        has03 = t03 in ratios.index
-        row["coarse r0.3"] = ratios.loc[t03, window] if has03 else float("nan")
-        row["coarse r0.3 s.e."] = errors.loc[t03, window] if has03 else float("nan")
+        put("coarse r0.3", SHELL03_TAILS.get(key))
         row["coarse/coarse r0.3"] = row["coarse"] / row["coarse r0.3"]
         rows.append(row)
     return pd.DataFrame(rows).set_index("packing")

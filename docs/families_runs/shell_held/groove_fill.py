@@ -114,17 +114,23 @@ def _patch_windows() -> tuple[float, ...]:
     return tuple(load_script(Path(__file__).resolve().parent / "compare.py", "shell_held_compare").PATCH_WINDOWS)
 
 
+def range_weights(slices: pd.DataFrame, lo: float, tag: str, length_m: float, half_chord_m: float) -> np.ndarray:
+    """Each slice's share inside the range ``tag`` of :data:`RANGES` of the window starting at ``lo`` (from
+    lo * L + a * h to (lo + 0.2) * L + b * h)."""
+    pa, pb = RANGES[tag]
+    a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
+    x0, x1 = slices["x_lo_m"].to_numpy(), slices["x_hi_m"].to_numpy()
+    return np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
+
+
 def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> pd.DataFrame:
     """Per window (patch centre from lo to lo + 0.2 of the block), the groove's solid fraction and grain volume over
-    each range of :data:`RANGES` (from lo * L + a * h to (lo + 0.2) * L + b * h), each slice weighted by the part of
-    it inside the range."""
-    x0, x1 = slices["x_lo_m"].to_numpy(), slices["x_hi_m"].to_numpy()
+    each range of :data:`RANGES`, each slice weighted by the part of it inside the range (:func:`range_weights`)."""
     rows = []
     for lo in _patch_windows():
         row = {"patch_lo_1": lo}
-        for tag, (pa, pb) in RANGES.items():
-            a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
-            w = np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
+        for tag in RANGES:
+            w = range_weights(slices, lo, tag, length_m, half_chord_m)
             row[f"solid_fraction_{tag}_1"] = float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
             row[f"grain_volume_{tag}_mm3"] = float((w * slices["grain_volume_m3"]).sum() * 1e9)
         rows.append(row)
@@ -154,15 +160,12 @@ def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_ch
         raise ValueError(f"layer_fill: heights {tuple(heights_mm)} mm must be increasing, positive multiples of the "
                          f"grid step {STEP_M * 1e3:g} mm and below the groove's top ({(top - tip) * 1e3:.3f} mm above "
                          "the tip)")
-    pa, pb = RANGES[where]
     cum = []  # per top: (solid points, points) per window
     for top_k in (*(tip + h), None):
         t = solid_in_groove(x, r, geo, length_m, slice_m, top_m=top_k)
-        x0, x1 = t["x_lo_m"].to_numpy(), t["x_hi_m"].to_numpy()
         per = []
         for lo in _patch_windows():
-            a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
-            w = np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
+            w = range_weights(t, lo, where, length_m, half_chord_m)
             per.append(((w * t["solid_points"]).sum(), (w * t["points"]).sum()))
         cum.append(np.array(per))
     rows = []

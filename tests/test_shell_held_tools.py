@@ -176,13 +176,14 @@ def _flat(path: Path) -> dict:
     return dict(walk(yaml.safe_load(path.read_text())))
 
 
-def test_session42_to_44_cases_change_only_the_packing_seed_or_the_dumps():
+def test_session42_to_45_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
     tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),  # 505: no r 0.3 mm
-             606: ("_unrel_band",)}  # 606 (session 44): the band pair only
-    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k606*.yaml")) == [
-        "lin_red_s100_p1p9_k606_unrel_band.yaml", "lin_red_s100_p7p6_k606_unrel_band.yaml"]
-    for seed in (404, 505, 606):
+             606: ("_unrel_band",), 707: ("_unrel_band",)}  # 606, 707 (sessions 44, 45): the band pair only
+    for seed in (606, 707):
+        assert sorted(f.name for f in rec.glob(f"lin_red_s100_*_k{seed}*.yaml")) == [
+            f"lin_red_s100_p1p9_k{seed}_unrel_band.yaml", f"lin_red_s100_p7p6_k{seed}_unrel_band.yaml"]
+    for seed in (404, 505, 606, 707):
         for p in ("1p9", "7p6"):
             for tail in tails[seed]:
                 a = _flat(rec / f"lin_red_s100_p{p}_k{seed}{tail}.yaml")
@@ -398,6 +399,69 @@ def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
     m = (ts["step"] > 21000) & (ts["step"] <= 28000)
     assert d["force_normal_N_before"].iloc[4] == pytest.approx(ts.loc[m, "force_normal_N"].mean())
     assert d["force_normal_N_after"].iloc[3] == pytest.approx(d["force_normal_N_before"].iloc[4], abs=1.0)  # 1 row apart
+
+
+def test_rendered_fill_at_dumps_is_the_slices_fill_over_each_span():
+    """groove_fill.rendered_at_dumps on slices full of rock below x = 13 mm and empty beyond (block 26 mm, half chord
+    2 mm): each dump's fill ahead is the part of [edge, edge + a] below 13 mm, cut at the block's end; under the disc,
+    of [centre, edge]; dump_links ranks F_n with each column."""
+    mod = load_script(HELD / "groove_fill.py")
+    L, h = 26e-3, 2e-3
+    edges = np.arange(0, L + 1e-9, 1e-4)
+    s = pd.DataFrame({"x_lo_m": edges[:-1], "x_hi_m": edges[1:], "points": 50,
+                      "solid_points": np.where(edges[:-1] < 13e-3 - 1e-12, 50, 0)})
+    patch = np.array([0.02, 0.3, 0.4, 0.45, 0.5, 0.9])
+    d = pd.DataFrame({"case": "c", "step": np.arange(6) * 1000, "patch_centre_1": patch, "force_normal_N_before": 1.0,
+                      "force_normal_N_after": [9.0, 50.0, 40.0, 30.0, 20.0, 10.0]})
+    t = mod.rendered_at_dumps(s, d, L, h)
+    assert t["step"].tolist() == [1000, 2000, 3000, 4000, 5000]  # past patch 0.05 only
+    centre = patch[1:] * L - h / 2
+    edge = centre + h
+    for a in (1.0, 2.0, 5.0, 10.0):
+        hi = np.minimum(edge + a * 1e-3, L)
+        want = np.clip((13e-3 - edge) / (hi - edge), 0, 1)
+        assert t[f"solid_fraction_rendered_ahead{a:g}mm_1"].to_numpy() == pytest.approx(want, abs=1e-9)
+    assert t["solid_fraction_rendered_under_1"].to_numpy() == pytest.approx(np.clip((13e-3 - centre) / h, 0, 1), abs=1e-9)
+    # patch 0.9: the leading edge at 23.4 mm, so 10 mm ahead is cut to the block's 2.6 mm
+    assert t["solid_fraction_rendered_ahead10mm_1"].iloc[-1] == 0.0 and t["solid_fraction_rendered_ahead5mm_1"].iloc[0] == pytest.approx(0.84)
+    links = mod.dump_links(t).set_index("fill")
+    # 5 mm ahead: 0.84 / 0.32 / 0.06 / 0 / 0 against F_n 50 / 40 / 30 / 20 / 10 N: ranks 5, 4, 3, 1.5, 1.5 against
+    # 5 ... 1, so rho = 9.5 / sqrt(9.5 * 10)
+    assert t["solid_fraction_rendered_ahead5mm_1"].to_numpy() == pytest.approx([0.84, 0.32, 0.06, 0.0, 0.0], abs=1e-9)
+    assert links.loc["solid_fraction_rendered_ahead5mm_1", "spearman_rho_1"] == pytest.approx(9.5 / np.sqrt(95.0))
+    assert (links["dumps"] == 5).all()
+    with pytest.raises(ValueError, match="no dump past patch 0.95"):
+        mod.rendered_at_dumps(s, d, L, h, from_patch=0.95)
+
+
+def test_recorded_dumps_of_606_load_up_to_one_break_and_the_local_rock_does_not_rank():
+    """groove_fill_dumps.csv (groove_fill.py --dumps, 606's shallow band run added in session 45) and
+    groove_fill_rendered_at_dumps.csv (--rendered-at-dumps, session 45). On 606 F_n up to the next dump climbs from
+    187 N at patch 0.38 to 521 N at 0.52 and falls to 52 N by 0.54: its case window is one long load and one break.
+    The rock the disc meets next, as rendered, ranks with F_n at the dumps on 505 (1 mm ahead: 0.55) but not on 606
+    (-0.09); only the 10 mm ahead does on 606 (0.50). The crushed rock under the disc ranks on both (0.45 / 0.50)."""
+    mod = load_script(HELD / "groove_fill.py")
+    d = pd.read_csv(HELD / "groove_fill_dumps.csv")
+    k6 = d[d["case"] == "lin_red_s100_p1p9_k606_unrel_band"].set_index("step")
+    assert len(k6) == 56 and k6.index.tolist() == list(range(0, 550001, 10000))
+    fa = k6["force_normal_N_after"]
+    assert [fa[390000], fa[490000], fa[510000]] == pytest.approx([187.061, 520.648, 51.930], abs=1e-3)
+    assert fa[490000] > 2.5 * fa[390000] and fa.loc[510000:].max() < 60 and fa.loc[:380000].max() < 200
+    links = mod.dump_links(d[d["patch_centre_1"] > 0.05]).set_index(["case", "fill"])["spearman_rho_1"]
+    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186)):
+        name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
+        assert links[(name, "solid_fraction_all_under_1")] == pytest.approx(under, abs=1e-3)
+        assert links[(name, "solid_fraction_all_ahead_1")] == pytest.approx(ahead, abs=1e-3)
+    r = pd.read_csv(HELD / "groove_fill_rendered_at_dumps.csv")
+    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606)]
+    rl = mod.dump_links(r).set_index(["case", "fill"])["spearman_rho_1"]
+    got = {k: [rl[(f"lin_red_s100_p1p9_k{k}_unrel_band", f"solid_fraction_rendered_ahead{a}mm_1")] for a in (1, 2, 5, 10)]
+           for k in (505, 606)}
+    assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.235], abs=1e-3)
+    assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.501], abs=1e-3)
+    # the rendered rows are the dumps' own (same steps, F_n and patch centre)
+    m = r.merge(d, on=["case", "step"], suffixes=("", "_d"), validate="one_to_one")
+    assert len(m) == len(r) and (m["force_normal_N_after"] == m["force_normal_N_after_d"]).all()
 
 
 def test_recorded_band_windows_rank_with_the_groove_fill():

@@ -13,6 +13,7 @@ leading edge enters in the window.
     python docs/families_runs/shell_held/groove_fill.py X [X ...] [--slice-mm 0.1] [--out CSV] [--windows-out CSV] \
         [--pair-windows docs/families_runs/shell_held/linear_grain_pair_windows.csv] [--layers-out CSV]
     python docs/families_runs/shell_held/groove_fill.py --dumps X [X ...] [--ahead-mm 2] [--out CSV]
+    python docs/families_runs/shell_held/groove_fill.py --rendered-at-dumps DUMPS_CSV X [X ...] [--out CSV]
 
 ``X`` is a rendered run folder (``spec.json`` and ``specimen.data``; ``deckgen render`` alone is enough, no run
 needed). The rendered grains are the packing's shrunk by ``bonds.shrink_before_bonding`` (2 %), so the packing's
@@ -23,7 +24,9 @@ overlap and a trend along the cut shared by the runs can make a link where there
 it off), so they are not tests of a cause. ``--layers-out`` writes the touched range's fill per layer above the
 disc's tip (:func:`layer_fill`). With ``--dumps`` (``X/run`` run, ``X/parsed`` parsed) it follows the cut instead: at
 each dump the groove's fill under the disc and just ahead of it, by the body and by every grain
-(:func:`body_fill_at_dumps`): where the rock the disc meets next is still part of the body, loose, or gone.
+(:func:`body_fill_at_dumps`): where the rock the disc meets next is still part of the body, loose, or gone. With
+``--rendered-at-dumps`` (a ``--dumps`` table and the runs' renders) it sets each dump beside the packing as rendered
+(:func:`rendered_at_dumps`): the fill ahead of the leading edge over 1-10 mm and under the disc, ranked with F_n.
 """
 from __future__ import annotations
 
@@ -118,7 +121,11 @@ def range_weights(slices: pd.DataFrame, lo: float, tag: str, length_m: float, ha
     """Each slice's share inside the range ``tag`` of :data:`RANGES` of the window starting at ``lo`` (from
     lo * L + a * h to (lo + 0.2) * L + b * h)."""
     pa, pb = RANGES[tag]
-    a, b = lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m
+    return span_weights(slices, lo * length_m + pa * half_chord_m, (lo + 0.2) * length_m + pb * half_chord_m)
+
+
+def span_weights(slices: pd.DataFrame, a: float, b: float) -> np.ndarray:
+    """Each slice's share (0-1) inside x from ``a`` to ``b`` [m]."""
     x0, x1 = slices["x_lo_m"].to_numpy(), slices["x_hi_m"].to_numpy()
     return np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
 
@@ -233,6 +240,47 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
     return d
 
 
+def rendered_at_dumps(slices: pd.DataFrame, dumps: pd.DataFrame, length_m: float, half_chord_m: float,
+                      ahead_mm: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0), from_patch: float = 0.05) -> pd.DataFrame:
+    """At each dump of a :func:`body_fill_at_dumps` table past the patch centre ``from_patch`` (fraction of the block),
+    the groove's fill AS RENDERED (``slices``, :func:`solid_in_groove` of the run's rendered packing) from the disc's
+    leading edge to ``a`` mm beyond it for each ``a`` of ``ahead_mm`` (``solid_fraction_rendered_ahead<a>mm_1``; a
+    range past the block's end is cut at it) and under the disc, from its centre to its leading edge
+    (``solid_fraction_rendered_under_1``), beside the dump's F_n (session 45: whether the rock the disc meets at
+    the moment, not the stretch it crosses in a window, sets F_n). The disc centre is the patch centre minus half
+    the half chord, as :func:`body_fill_at_dumps` puts it."""
+    d = dumps[dumps["patch_centre_1"] > from_patch].reset_index(drop=True)
+    if d.empty:
+        raise ValueError(f"rendered_at_dumps: no dump past patch {from_patch}")
+    out = d[["case", "step", "patch_centre_1", "force_normal_N_before", "force_normal_N_after"]].copy()
+    centre = d["patch_centre_1"].to_numpy() * length_m - half_chord_m / 2
+    edge = centre + half_chord_m
+
+    def fill(a: float, b: float) -> float:
+        w = span_weights(slices, a, min(b, length_m))
+        return float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
+
+    for mm in ahead_mm:
+        out[f"solid_fraction_rendered_ahead{mm:g}mm_1"] = [fill(e, e + mm * 1e-3) for e in edge]
+    out["solid_fraction_rendered_under_1"] = [fill(c, e) for c, e in zip(centre, edge)]
+    return out
+
+
+def dump_links(table: pd.DataFrame) -> pd.DataFrame:
+    """Spearman's rho of F_n up to the next dump with each fill column of a :func:`body_fill_at_dumps` or
+    :func:`rendered_at_dumps` table, per case. The p values are nominal: neighbouring dumps share their rock and a
+    loading cycle spans several dumps, so the dumps are not independent."""
+    from scipy.stats import spearmanr
+
+    rows = []
+    for case, g in table.groupby("case", sort=False):
+        for col in (c for c in g.columns if c.startswith("solid_fraction_")):
+            ok = g[col].notna() & g["force_normal_N_after"].notna()
+            rho, p = spearmanr(g.loc[ok, col], g.loc[ok, "force_normal_N_after"])
+            rows.append({"case": case, "fill": col, "dumps": int(ok.sum()), "spearman_rho_1": rho, "p_nominal_1": p})
+    return pd.DataFrame(rows)
+
+
 def within_run_permutation(groups: list[tuple[np.ndarray, np.ndarray]], max_exact: int = 10**7,
                            draws: int = 200_000, seed: int = 43) -> tuple[float, float]:
     """The mean over runs of each run's own Spearman rho (fill against F_n over its windows) and its two-sided p under
@@ -323,6 +371,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="each argument is a folder X with X/run (run) and X/parsed (deckgen parse): the fill under and "
                          "ahead of the disc at each dump (body_fill_at_dumps) instead")
     ap.add_argument("--ahead-mm", type=float, default=2.0, help="--dumps: how far beyond the disc's leading edge")
+    ap.add_argument("--rendered-at-dumps", type=Path, metavar="DUMPS_CSV",
+                    help="a --dumps table (groove_fill_dumps.csv): for each rendered run X whose case it holds, the "
+                         "rendered fill ahead of and under the disc at its dumps and their rank correlation with F_n "
+                         "(rendered_at_dumps, dump_links); --out writes the per-dump table")
     ap.add_argument("--layers-out", type=Path,
                     help="per window and layer above the tip (layer_fill, touched range; heights 0.2/0.4/0.6/0.8 mm)")
     a = ap.parse_args(argv)
@@ -339,6 +391,28 @@ def main(argv: list[str] | None = None) -> int:
                 print(d.drop(columns="case").round(3).to_string(index=False))
         if a.out:
             pd.concat(tables).to_csv(a.out, index=False, float_format="%.6g")
+        return 0
+    if a.rendered_at_dumps:
+        dumps = pd.read_csv(a.rendered_at_dumps)
+        tables = []
+        for run in a.runs:
+            for need in ("spec.json", "specimen.data"):
+                if not (run / need).is_file():
+                    raise SystemExit(f"{run}: no {need}; give a folder written by deckgen render")
+            case, x, r = load(run)
+            mine = dumps[dumps["case"] == case.name]
+            if mine.empty:
+                raise SystemExit(f"{a.rendered_at_dumps}: no dumps of {case.name} (fix: groove_fill.py --dumps on its "
+                                 "run, or give its render)")
+            length_m = case.specimen.length_mm * 1e-3
+            geo = groove_geometry(case)
+            hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+            tables.append(rendered_at_dumps(solid_in_groove(x, r, geo, length_m, a.slice_mm * 1e-3), mine, length_m, hc))
+        t = pd.concat(tables)
+        with pd.option_context("display.width", 250):
+            print(dump_links(t).to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+        if a.out:
+            t.to_csv(a.out, index=False, float_format="%.6g")
         return 0
     all_slices, all_windows, all_layers = [], [], []
     for run in a.runs:

@@ -403,8 +403,8 @@ def test_groove_fill_at_the_dumps_of_the_reference_cut(cut_folder):
 
 def test_rendered_fill_at_dumps_is_the_slices_fill_over_each_span():
     """groove_fill.rendered_at_dumps on slices full of rock below x = 13 mm and empty beyond (block 26 mm, half chord
-    2 mm): each dump's fill ahead is the part of [edge, edge + a] below 13 mm, cut at the block's end; under the disc,
-    of [centre, edge]; dump_links ranks F_n with each column."""
+    2 mm): each dump's fill ahead is the part of [edge, edge + a] below 13 mm, NaN where that range runs past the
+    block's end; under the disc, of [centre, edge]; dump_links ranks F_n with each column."""
     mod = load_script(HELD / "groove_fill.py")
     L, h = 26e-3, 2e-3
     edges = np.arange(0, L + 1e-9, 1e-4)
@@ -418,28 +418,41 @@ def test_rendered_fill_at_dumps_is_the_slices_fill_over_each_span():
     centre = patch[1:] * L - h / 2
     edge = centre + h
     for a in (1.0, 2.0, 5.0, 10.0):
-        hi = np.minimum(edge + a * 1e-3, L)
-        want = np.clip((13e-3 - edge) / (hi - edge), 0, 1)
-        assert t[f"solid_fraction_rendered_ahead{a:g}mm_1"].to_numpy() == pytest.approx(want, abs=1e-9)
+        want = np.clip((13e-3 - edge) / (a * 1e-3), 0, 1)
+        want[edge + a * 1e-3 > L] = np.nan  # a range past the block's end is not taken
+        assert t[f"solid_fraction_rendered_ahead{a:g}mm_1"].to_numpy() == pytest.approx(want, abs=1e-9, nan_ok=True)
     assert t["solid_fraction_rendered_under_1"].to_numpy() == pytest.approx(np.clip((13e-3 - centre) / h, 0, 1), abs=1e-9)
-    # patch 0.9: the leading edge at 23.4 mm, so 10 mm ahead is cut to the block's 2.6 mm
-    assert t["solid_fraction_rendered_ahead10mm_1"].iloc[-1] == 0.0 and t["solid_fraction_rendered_ahead5mm_1"].iloc[0] == pytest.approx(0.84)
+    # patch 0.9: the leading edge at 24.4 mm (the patch centre 23.4 mm plus half the half chord), so 1 mm ahead lies on
+    # the block and 2, 5 or 10 mm do not; at patch 0.5 (edge 14 mm) 10 mm ahead ends at 24 mm, on the block
+    assert t["solid_fraction_rendered_ahead1mm_1"].iloc[-1] == 0.0
+    assert t[[f"solid_fraction_rendered_ahead{a}mm_1" for a in (2, 5, 10)]].iloc[-1].isna().all()
+    assert t["solid_fraction_rendered_ahead10mm_1"].iloc[3] == 0.0
     links = mod.dump_links(t).set_index("fill")
-    # 5 mm ahead: 0.84 / 0.32 / 0.06 / 0 / 0 against F_n 50 / 40 / 30 / 20 / 10 N: ranks 5, 4, 3, 1.5, 1.5 against
-    # 5 ... 1, so rho = 9.5 / sqrt(9.5 * 10)
-    assert t["solid_fraction_rendered_ahead5mm_1"].to_numpy() == pytest.approx([0.84, 0.32, 0.06, 0.0, 0.0], abs=1e-9)
-    assert links.loc["solid_fraction_rendered_ahead5mm_1", "spearman_rho_1"] == pytest.approx(9.5 / np.sqrt(95.0))
-    assert (links["dumps"] == 5).all()
+    # 1 mm ahead: 1 / 1 / 0.3 / 0 / 0 against F_n 50 / 40 / 30 / 20 / 10 N: ranks 4.5, 4.5, 3, 1.5, 1.5 against
+    # 5 ... 1, so rho = 9 / sqrt(9 * 10); 5 mm ahead over the four dumps whose range lies on the block: 0.84 / 0.32 /
+    # 0.06 / 0, the order of their F_n
+    assert t["solid_fraction_rendered_ahead1mm_1"].to_numpy() == pytest.approx([1.0, 1.0, 0.3, 0.0, 0.0], abs=1e-9)
+    assert links.loc["solid_fraction_rendered_ahead1mm_1", "spearman_rho_1"] == pytest.approx(9 / np.sqrt(90.0))
+    assert t["solid_fraction_rendered_ahead5mm_1"].iloc[:4].to_numpy() == pytest.approx([0.84, 0.32, 0.06, 0.0], abs=1e-9)
+    assert links.loc["solid_fraction_rendered_ahead5mm_1", ["dumps", "spearman_rho_1"]].tolist() == pytest.approx([4, 1.0])
+    assert links["dumps"].tolist() == [5, 4, 4, 4, 5]
+    # dump_links takes only the dumps past patch 0.05 itself: a dump at patch 0.02 added changes nothing
+    extra = t.iloc[:1].assign(patch_centre_1=0.02, force_normal_N_after=1000.0,
+                              **{c: 0.0 for c in t.columns if c.startswith("solid_fraction_")})
+    assert not mod.dump_links(pd.concat([extra, t]), from_patch=0.0).equals(mod.dump_links(t))
+    assert mod.dump_links(pd.concat([extra, t])).equals(mod.dump_links(t))
     with pytest.raises(ValueError, match="no dump past patch 0.95"):
         mod.rendered_at_dumps(s, d, L, h, from_patch=0.95)
 
 
-def test_recorded_dumps_of_606_load_up_to_one_break_and_the_local_rock_does_not_rank():
+def test_recorded_dumps_of_606_load_up_to_a_break_and_the_local_rock_does_not_rank():
     """groove_fill_dumps.csv (groove_fill.py --dumps, 606's shallow band run added in session 45) and
     groove_fill_rendered_at_dumps.csv (--rendered-at-dumps, session 45). On 606 F_n up to the next dump climbs from
-    187 N at patch 0.38 to 521 N at 0.52 and falls to 52 N by 0.54: its case window is one long load and one break.
-    The rock the disc meets next, as rendered, ranks with F_n at the dumps on 505 (1 mm ahead: 0.55) but not on 606
-    (-0.09); only the 10 mm ahead does on 606 (0.50). The crushed rock under the disc ranks on both (0.45 / 0.50)."""
+    187 N at patch 0.38 to 521 N at 0.52 (a 35-grain piece coming off at 0.43 on the way) and falls to 52 N by 0.54,
+    when a 39-grain piece breaks off: its case window is mostly one long load. The rock the disc meets next, as
+    rendered, ranks with F_n at the dumps on 505 (1 mm ahead: 0.55) but not on 606 (-0.09); on 606 only the 10 mm
+    ahead does (0.66, over the 32 dumps whose 10 mm lie on the block). The crushed rock under the disc ranks on both
+    (0.45 / 0.50)."""
     mod = load_script(HELD / "groove_fill.py")
     d = pd.read_csv(HELD / "groove_fill_dumps.csv")
     k6 = d[d["case"] == "lin_red_s100_p1p9_k606_unrel_band"].set_index("step")
@@ -447,6 +460,10 @@ def test_recorded_dumps_of_606_load_up_to_one_break_and_the_local_rock_does_not_
     fa = k6["force_normal_N_after"]
     assert [fa[390000], fa[490000], fa[510000]] == pytest.approx([187.061, 520.648, 51.930], abs=1e-3)
     assert fa[490000] > 2.5 * fa[390000] and fa.loc[510000:].max() < 60 and fa.loc[:380000].max() < 200
+    pt = pd.read_csv(HELD / "piece_timeline_k606_unrel_band_p1p9.csv")
+    big = pt[pt["largest_piece_grains"] >= 30]
+    assert big["patch_centre_1"].iloc[0] == pytest.approx(0.43, abs=0.01) and big["largest_piece_grains"].iloc[0] == 35
+    assert pt.loc[pt["largest_piece_grains"] == 39, "patch_centre_1"].iloc[0] == pytest.approx(0.53, abs=0.01)
     links = mod.dump_links(d[d["patch_centre_1"] > 0.05]).set_index(["case", "fill"])["spearman_rho_1"]
     for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186)):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
@@ -457,11 +474,15 @@ def test_recorded_dumps_of_606_load_up_to_one_break_and_the_local_rock_does_not_
     rl = mod.dump_links(r).set_index(["case", "fill"])["spearman_rho_1"]
     got = {k: [rl[(f"lin_red_s100_p1p9_k{k}_unrel_band", f"solid_fraction_rendered_ahead{a}mm_1")] for a in (1, 2, 5, 10)]
            for k in (505, 606)}
-    assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.235], abs=1e-3)
-    assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.501], abs=1e-3)
-    # the rendered rows are the dumps' own (same steps, F_n and patch centre)
+    assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.234], abs=1e-3)
+    assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.655], abs=1e-3)
+    k6r = r[r["case"] == "lin_red_s100_p1p9_k606_unrel_band"]
+    assert len(k6r) == 41 and k6r["solid_fraction_rendered_ahead10mm_1"].notna().sum() == 32
+    # the rendered rows are the dumps' own (same steps, patch centres and F_n)
     m = r.merge(d, on=["case", "step"], suffixes=("", "_d"), validate="one_to_one")
-    assert len(m) == len(r) and (m["force_normal_N_after"] == m["force_normal_N_after_d"]).all()
+    assert len(m) == len(r)
+    for col in ("patch_centre_1", "force_normal_N_before", "force_normal_N_after"):
+        assert m[col].to_numpy() == pytest.approx(m[f"{col}_d"].to_numpy(), nan_ok=True)
 
 
 def test_recorded_band_windows_rank_with_the_groove_fill():

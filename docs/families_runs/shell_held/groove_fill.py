@@ -244,11 +244,12 @@ def rendered_at_dumps(slices: pd.DataFrame, dumps: pd.DataFrame, length_m: float
                       ahead_mm: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0), from_patch: float = 0.05) -> pd.DataFrame:
     """At each dump of a :func:`body_fill_at_dumps` table past the patch centre ``from_patch`` (fraction of the block),
     the groove's fill AS RENDERED (``slices``, :func:`solid_in_groove` of the run's rendered packing) from the disc's
-    leading edge to ``a`` mm beyond it for each ``a`` of ``ahead_mm`` (``solid_fraction_rendered_ahead<a>mm_1``; a
-    range past the block's end is cut at it) and under the disc, from its centre to its leading edge
-    (``solid_fraction_rendered_under_1``), beside the dump's F_n (session 45: whether the rock the disc meets at
-    the moment, not the stretch it crosses in a window, sets F_n). The disc centre is the patch centre minus half
-    the half chord, as :func:`body_fill_at_dumps` puts it."""
+    leading edge to ``a`` mm beyond it for each ``a`` of ``ahead_mm`` (``solid_fraction_rendered_ahead<a>mm_1``) and
+    under the disc, from its centre to its leading edge (``solid_fraction_rendered_under_1``), beside the dump's F_n
+    (session 45: whether the rock the disc meets at the moment, not the stretch it crosses in a window, sets F_n). A
+    range that does not lie wholly on the block (0 to the block's length) is NaN, so every value of a column is taken
+    over the same length. The disc centre is the patch centre minus half the half chord, as
+    :func:`body_fill_at_dumps` puts it."""
     d = dumps[dumps["patch_centre_1"] > from_patch].reset_index(drop=True)
     if d.empty:
         raise ValueError(f"rendered_at_dumps: no dump past patch {from_patch}")
@@ -257,7 +258,9 @@ def rendered_at_dumps(slices: pd.DataFrame, dumps: pd.DataFrame, length_m: float
     edge = centre + half_chord_m
 
     def fill(a: float, b: float) -> float:
-        w = span_weights(slices, a, min(b, length_m))
+        if a < 0.0 or b > length_m:
+            return float("nan")
+        w = span_weights(slices, a, b)
         return float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
 
     for mm in ahead_mm:
@@ -266,14 +269,15 @@ def rendered_at_dumps(slices: pd.DataFrame, dumps: pd.DataFrame, length_m: float
     return out
 
 
-def dump_links(table: pd.DataFrame) -> pd.DataFrame:
+def dump_links(table: pd.DataFrame, from_patch: float = 0.05) -> pd.DataFrame:
     """Spearman's rho of F_n up to the next dump with each fill column of a :func:`body_fill_at_dumps` or
-    :func:`rendered_at_dumps` table, per case. The p values are nominal: neighbouring dumps share their rock and a
-    loading cycle spans several dumps, so the dumps are not independent."""
+    :func:`rendered_at_dumps` table, per case, over the dumps past the patch centre ``from_patch`` (before it the
+    disc has hardly entered the block) where both are known. The p values are nominal: neighbouring dumps share their
+    rock and a loading cycle spans several dumps, so the dumps are not independent."""
     from scipy.stats import spearmanr
 
     rows = []
-    for case, g in table.groupby("case", sort=False):
+    for case, g in table[table["patch_centre_1"] > from_patch].groupby("case", sort=False):
         for col in (c for c in g.columns if c.startswith("solid_fraction_")):
             ok = g[col].notna() & g["force_normal_N_after"].notna()
             rho, p = spearmanr(g.loc[ok, col], g.loc[ok, "force_normal_N_after"])

@@ -70,6 +70,21 @@ def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, sl
     ``top_m`` (default: the highest grain top, as grains standing above the block's nominal top meet the disc too); a
     point is solid when it lies within a grain's radius of the grain's centre.
     """
+    rows = []
+    for lo, hi, z, solid, area in _sampled_slices(x, r, geo, length_m, slice_m, step_m, top_m, from_m):
+        rows.append({"x_lo_m": lo, "x_hi_m": hi, "points": len(z), "solid_points": int(solid.sum()),
+                     "groove_area_m2": area})
+    t = pd.DataFrame(rows)
+    t["solid_fraction_1"] = t["solid_points"] / t["points"]
+    t["grain_volume_m3"] = t["solid_fraction_1"] * t["groove_area_m2"] * (t["x_hi_m"] - t["x_lo_m"])
+    return t
+
+
+def _sampled_slices(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, slice_m: float, step_m: float,
+                    top_m: float | None, from_m: float):
+    """:func:`solid_in_groove`'s sampling, per slice: (x low, x high, each sample point's z, whether it is solid, the
+    groove's sampled cross-section area). A grid of rows (i + 1/2) steps above the disc's tip in the groove's
+    cross-section, repeated on evenly spaced planes of x in each slice."""
     from matplotlib.path import Path as MplPath
     from scipy.spatial import cKDTree
 
@@ -86,7 +101,6 @@ def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, sl
     tree = cKDTree(x)
     rmax = float(r.max())
     k = min(NEAREST, len(x))
-    rows = []
     # slices of equal length covering from_m to length_m, each sampled on the same number of evenly spaced planes
     edges = np.linspace(from_m, length_m, max(1, round((length_m - from_m) / slice_m)) + 1)
     for lo, hi in zip(edges[:-1], edges[1:]):
@@ -95,13 +109,7 @@ def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, sl
         pts = np.column_stack([np.repeat(xs, len(yz)), np.tile(yz, (len(xs), 1))])
         d, j = tree.query(pts, k=k, distance_upper_bound=rmax)
         rj = np.where(j < len(x), r[np.minimum(j, len(x) - 1)], 0.0)
-        solid = (d < rj).any(axis=1)
-        rows.append({"x_lo_m": lo, "x_hi_m": hi, "points": len(pts), "solid_points": int(solid.sum()),
-                     "groove_area_m2": len(yz) * step_m**2})
-    t = pd.DataFrame(rows)
-    t["solid_fraction_1"] = t["solid_points"] / t["points"]
-    t["grain_volume_m3"] = t["solid_fraction_1"] * t["groove_area_m2"] * (t["x_hi_m"] - t["x_lo_m"])
-    return t
+        yield lo, hi, pts[:, 2], (d < rj).any(axis=1), len(yz) * step_m**2
 
 
 #: x ranges of a window [lo, lo + 0.2] of the patch centre (fractions of the block length L; h = the patch's half chord):
@@ -149,10 +157,10 @@ def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_ch
                slice_m: float = 1e-4) -> pd.DataFrame:
     """Per window (:func:`window_fill`'s, over the range ``where`` of :data:`RANGES`), the groove's solid fraction in
     layers above the disc's tip: from the tip to ``heights_mm[0]`` above it, between consecutive heights, and from the
-    last height to the groove's top (the highest grain top; ``layer_hi_mm`` NaN). Each layer's fraction is the
-    difference of the groove's solid and total sample points below its two bounds (:func:`solid_in_groove` with
-    ``top_m``), so the layers share one grid and their points add up to the whole groove's; ``points`` is that count
-    weighted by each slice's overlap with the range (fractional). The grid's rows lie at (i + 1/2) grid steps above the
+    last height to the groove's top (the highest grain top; ``layer_hi_mm`` NaN). Each layer's fraction is the share
+    of :func:`solid_in_groove`'s sample points between its two bounds that lie in a grain, from one pass over the grid
+    (each point counted in the layer its z falls in), so the layers' points add up to the whole groove's; ``points``
+    is that count weighted by each slice's overlap with the range (fractional). The grid's rows lie at (i + 1/2) grid steps above the
     tip, so the heights must be whole multiples of the step (0.04 mm; no row then sits on a bound), increasing, and
     below the groove's top (session 44: whether the rock standing across the tip plane carries the link of the
     windows' F_n with the fill)."""
@@ -167,22 +175,24 @@ def layer_fill(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, half_ch
         raise ValueError(f"layer_fill: heights {tuple(heights_mm)} mm must be increasing, positive multiples of the "
                          f"grid step {STEP_M * 1e3:g} mm and below the groove's top ({(top - tip) * 1e3:.3f} mm above "
                          "the tip)")
-    cum = []  # per top: (solid points, points) per window
-    for top_k in (*(tip + h), None):
-        t = solid_in_groove(x, r, geo, length_m, slice_m, top_m=top_k)
-        per = []
-        for lo in _patch_windows():
-            w = range_weights(t, lo, where, length_m, half_chord_m)
-            per.append(((w * t["solid_points"]).sum(), (w * t["points"]).sum()))
-        cum.append(np.array(per))
+    bounds_m = tip + h
+    n_layers = len(h) + 1
+    per_slice = []  # per slice: x range, then solid points and points per layer
+    for lo, hi, z, solid, _ in _sampled_slices(x, r, geo, length_m, slice_m, STEP_M, None, 0.0):
+        layer = np.searchsorted(bounds_m, z)  # 0 below the first bound ... len(h) above the last
+        per_slice.append((lo, hi, np.bincount(layer[solid], minlength=n_layers),
+                          np.bincount(layer, minlength=n_layers)))
+    t = pd.DataFrame({"x_lo_m": [p[0] for p in per_slice], "x_hi_m": [p[1] for p in per_slice]})
+    solid_k = np.array([p[2] for p in per_slice], dtype=float)  # slices x layers
+    points_k = np.array([p[3] for p in per_slice], dtype=float)
     rows = []
     bounds = (0.0, *heights_mm, float("nan"))
-    for i, lo in enumerate(_patch_windows()):
-        for k in range(len(cum)):
-            solid = cum[k][i, 0] - (cum[k - 1][i, 0] if k else 0.0)
-            pts = cum[k][i, 1] - (cum[k - 1][i, 1] if k else 0.0)
+    for lo in _patch_windows():
+        w = range_weights(t, lo, where, length_m, half_chord_m)
+        solid, pts = w @ solid_k, w @ points_k
+        for k in range(n_layers):
             rows.append({"patch_lo_1": lo, "layer_lo_mm": bounds[k], "layer_hi_mm": bounds[k + 1],
-                         "points": pts, "solid_fraction_1": solid / pts})
+                         "points": pts[k], "solid_fraction_1": solid[k] / pts[k]})
     return pd.DataFrame(rows)
 
 

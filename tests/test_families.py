@@ -2055,7 +2055,8 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert r6.loc["_k606_unrel_band"].tolist() == pytest.approx([2.629, 1.336, 0.472, 0.483], abs=1e-3)
     rep6 = mod.packing_replicates()
     assert rep6.loc[606, "band"] == pytest.approx(0.483, abs=1e-3) and rep6.loc[606, ["coarse", "band/coarse"]].isna().all()
-    s6 = mod.packing_spread()
+    six = (12345, 202, 303, 404, 505, 606)
+    s6 = mod.packing_spread(packings=six)
     assert s6["packings"].to_dict() == {"band": 6, "coarse": 5, "band/coarse": 5, "coarse r0.3": 4,
                                         "coarse/coarse r0.3": 4}
     assert s6.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.480, 0.796, 2.753],
@@ -2065,3 +2066,26 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert s6.loc[["coarse", "band/coarse"]].to_numpy() == pytest.approx(s5.loc[["coarse", "band/coarse"]].to_numpy())
     gm6 = np.exp(np.log(r6.loc[bands + ["_k606_unrel_band"]]).mean())
     assert gm6.tolist() == pytest.approx([1.159, 1.006, 0.929, 1.480], abs=1e-3)
+    # packing 707 (session 45, the band pair only): its shallow cut is strongest in window 0.1 (a 70-grain piece breaks
+    # off at patch 0.245, the largest of the band runs) and its deep cut rises along the cut, so the ratio rises from
+    # x0.65 to x1.40; over seven packings the case window is x1.47 (t 95 % 0.89-2.42, holding 1) and the earlier
+    # windows near 1
+    b7 = t.loc[(33, "free", 707, "band")]
+    assert [b7["grains p1p9"], b7["grains p7p6"]] == [5650, 5650]
+    assert [b7["F_n N p1p9"], b7["F_n N p7p6"]] == pytest.approx([118.009, 165.593], abs=1e-3)
+    assert [b7["largest chip grains p1p9"], b7["largest chip grains p7p6"]] == [69, 44]
+    assert w.loc["lin_red_s100_p1p9_k707_unrel_band"].tolist() == pytest.approx([158.859, 113.320, 92.631, 118.009], abs=1e-3)
+    assert w.loc["lin_red_s100_p7p6_k707_unrel_band"].tolist() == pytest.approx([103.480, 108.698, 117.962, 165.593],
+                                                                                abs=1e-3)
+    assert r6.loc["_k707_unrel_band"].tolist() == pytest.approx([0.651, 0.959, 1.273, 1.403], abs=1e-3)
+    assert rep6.loc[707, "band"] == pytest.approx(1.403, abs=1e-3) and rep6.loc[707, ["coarse", "band/coarse"]].isna().all()
+    s7 = mod.packing_spread()
+    assert s7["packings"].to_dict() == {"band": 7, "coarse": 5, "band/coarse": 5, "coarse r0.3": 4,
+                                        "coarse/coarse r0.3": 4}
+    assert s7.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.469, 0.891, 2.421],
+                                                                                              abs=1e-3)
+    assert s7.loc["band", "95% low"] < 1 < s7.loc["band", "95% low within"]
+    assert s7.loc["band", ["log sd between packings", "log s.e. within runs (rms)"]].tolist() == pytest.approx(
+        [0.540, 0.423], abs=1e-3)
+    gm7 = np.exp(np.log(r6.loc[bands + ["_k606_unrel_band", "_k707_unrel_band"]]).mean())
+    assert gm7.tolist() == pytest.approx([1.067, 0.999, 0.972, 1.469], abs=1e-3)

@@ -465,17 +465,19 @@ def test_recorded_dumps_of_606_load_up_to_a_break_and_the_local_rock_does_not_ra
     assert big["patch_centre_1"].iloc[0] == pytest.approx(0.43, abs=0.01) and big["largest_piece_grains"].iloc[0] == 35
     assert pt.loc[pt["largest_piece_grains"] == 39, "patch_centre_1"].iloc[0] == pytest.approx(0.53, abs=0.01)
     links = mod.dump_links(d[d["patch_centre_1"] > 0.05]).set_index(["case", "fill"])["spearman_rho_1"]
-    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186)):
+    # 707 (session 45, its 55 dumps): the crushed rock under the disc ranks again (0.65), the rock ahead against F_n
+    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186), (707, 0.652, -0.371)):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
         assert links[(name, "solid_fraction_all_under_1")] == pytest.approx(under, abs=1e-3)
         assert links[(name, "solid_fraction_all_ahead_1")] == pytest.approx(ahead, abs=1e-3)
     r = pd.read_csv(HELD / "groove_fill_rendered_at_dumps.csv")
-    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606)]
+    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606, 707)]
     rl = mod.dump_links(r).set_index(["case", "fill"])["spearman_rho_1"]
     got = {k: [rl[(f"lin_red_s100_p1p9_k{k}_unrel_band", f"solid_fraction_rendered_ahead{a}mm_1")] for a in (1, 2, 5, 10)]
-           for k in (505, 606)}
+           for k in (505, 606, 707)}
     assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.234], abs=1e-3)
     assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.655], abs=1e-3)
+    assert got[707] == pytest.approx([-0.239, -0.484, -0.482, -0.355], abs=1e-3)
     k6r = r[r["case"] == "lin_red_s100_p1p9_k606_unrel_band"]
     assert len(k6r) == 41 and k6r["solid_fraction_rendered_ahead10mm_1"].notna().sum() == 32
     # the rendered rows are the dumps' own (same steps, patch centres and F_n)
@@ -491,17 +493,20 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
     over the rock its patch touches within each run (exact permutation p 0.0009), and packing 505's window order was
     both fills' (predicted before its run). On 606 (session 44) the two fills disagree: the touched range's order
     (registered as the prediction) came out reversed, the leading edge's exactly; over six packings the leading edge's
-    fill is the link that holds, with or without the window means. The deep cut shows none."""
+    fill is the link that holds, with or without the window means. On 707 (session 45) the leading edge's order was
+    registered and F_n came out in its exact reverse; over seven packings its within-run link is 0.49. The deep cut
+    shows none."""
     mod = load_script(HELD / "groove_fill.py")
     fill = pd.read_csv(HELD / "groove_fill_windows.csv")
     windows = pd.read_csv(HELD / "linear_grain_pair_windows.csv")
     band = fill[fill["case"].str.endswith("_band")]
-    assert sorted(set(band["packing_seed"])) == [202, 303, 404, 505, 606, 12345] and len(band) == 48
+    assert sorted(set(band["packing_seed"])) == [202, 303, 404, 505, 606, 707, 12345] and len(band) == 56
     shallow, deep = 0.95, 3.8
-    a5 = mod.against_forces(band[band["packing_seed"] != 606], windows).set_index(["penetration_mm", "fill", "how"])
+    a5 = mod.against_forces(band[~band["packing_seed"].isin([606, 707])], windows).set_index(
+        ["penetration_mm", "fill", "how"])
     assert a5.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
         [0.800, 0.00089], abs=1e-5)
-    a = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
+    a = mod.against_forces(band[band["packing_seed"] != 707], windows).set_index(["penetration_mm", "fill", "how"])
     assert a.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
         [0.7333, 0.0010], abs=1e-4)
     assert a.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.716, abs=1e-3)
@@ -511,15 +516,28 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
     for tag in mod.RANGES:
         assert abs(a.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.25
     # 505: its four windows' F_n in the order of both fills (0.4 > 0.3 > 0.1 > 0.2); 606: the fills disagree, F_n takes
-    # the leading edge's order (0.4 > 0.3 > 0.2 > 0.1), the touched range's reversed
-    for seed, orders in ((505, {"touched": [0.4, 0.3, 0.1, 0.2], "front": [0.4, 0.3, 0.1, 0.2]}),
-                         (606, {"touched": [0.1, 0.2, 0.3, 0.4], "front": [0.4, 0.3, 0.2, 0.1]})):
+    # the leading edge's order (0.4 > 0.3 > 0.2 > 0.1), the touched range's reversed; 707 (session 45, the leading
+    # edge's order registered): F_n takes its exact reverse (0.1 > 0.4 > 0.2 > 0.3)
+    for seed, orders, fn_order in (
+            (505, {"touched": [0.4, 0.3, 0.1, 0.2], "front": [0.4, 0.3, 0.1, 0.2]}, [0.4, 0.3, 0.1, 0.2]),
+            (606, {"touched": [0.1, 0.2, 0.3, 0.4], "front": [0.4, 0.3, 0.2, 0.1]}, [0.4, 0.3, 0.2, 0.1]),
+            (707, {"touched": [0.4, 0.3, 0.2, 0.1], "front": [0.3, 0.2, 0.4, 0.1]}, [0.1, 0.4, 0.2, 0.3])):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
         f = band[band["case"] == name].set_index("patch_lo_1")
         for tag, order in orders.items():
             assert f[f"solid_fraction_{tag}_1"].sort_values(ascending=False).index.tolist() == order
         fn = windows[windows["case"] == name].set_index("patch_lo_1")["force_normal_N_mean_steady"]
-        assert fn.sort_values(ascending=False).index.tolist() == orders["front"]
+        assert fn.sort_values(ascending=False).index.tolist() == fn_order
+    # seven packings: the leading edge's within-run link falls to 0.49 (p 0.029), two-way 0.41; the touched range's
+    # 0.37 (p 0.10); the deep cut still none
+    a7 = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
+    assert a7.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
+        [0.4857, 0.0289], abs=1e-4)
+    assert a7.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.408, abs=1e-3)
+    assert a7.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
+        [0.3714, 0.1017], abs=1e-4)
+    for tag in mod.RANGES:
+        assert abs(a7.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
 
 
 def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
@@ -529,13 +547,18 @@ def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
     lay = pd.read_csv(HELD / "groove_fill_layers.csv")
     fill = pd.read_csv(HELD / "groove_fill_windows.csv")
     windows = pd.read_csv(HELD / "linear_grain_pair_windows.csv")[["case", "patch_lo_1", "force_normal_N_mean_steady"]]
-    assert sorted(set(lay["packing_seed"])) == [202, 303, 404, 505, 606, 12345] and (lay["penetration_mm"] == 0.95).all()
+    assert sorted(set(lay["packing_seed"])) == [202, 303, 404, 505, 606, 707, 12345] and (lay["penetration_mm"] == 0.95).all()
     pooled = lay.assign(s=lay["solid_fraction_1"] * lay["points"]).groupby(["case", "patch_lo_1"])[["s", "points"]].sum()
     whole = fill.set_index(["case", "patch_lo_1"]).loc[pooled.index, "solid_fraction_touched_1"]
     assert (pooled["s"] / pooled["points"]).to_numpy() == pytest.approx(whole.to_numpy(), abs=2e-6)  # CSV rounding
-    five = lay[lay["packing_seed"] != 606].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+    five = lay[~lay["packing_seed"].isin([606, 707])].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
     rho = {lo: np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
                         for _, g in by.groupby("case")]) for lo, by in five.groupby("layer_lo_mm")}
     assert list(rho) == [0.0, 0.2, 0.4, 0.6, 0.8]
     assert list(rho.values()) == pytest.approx([0.12, 0.32, 0.48, 0.40, 0.44], abs=1e-9)
     assert max(rho.values()) < 0.8 and min(rho, key=rho.get) == 0.0
+    # seven packings (606, 707 added): no layer links (707's layers all rank against its F_n, -0.4 to -1)
+    seven = lay.merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+    rho7 = [np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
+                     for _, g in by.groupby("case")]) for _, by in seven.groupby("layer_lo_mm")]
+    assert rho7 == pytest.approx([0.086, 0.200, 0.114, 0.0, 0.029], abs=1e-3)

@@ -179,10 +179,11 @@ def _flat(path: Path) -> dict:
 def test_session42_to_45_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
     tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),  # 505: no r 0.3 mm
-             606: ("_unrel_band",), 707: ("_unrel_band",)}  # 606, 707 (sessions 44, 45): the band pair only
-    for seed in (606, 707):
-        assert sorted(f.name for f in rec.glob(f"lin_red_s100_*_k{seed}*.yaml")) == [
-            f"lin_red_s100_p1p9_k{seed}_unrel_band.yaml", f"lin_red_s100_p7p6_k{seed}_unrel_band.yaml"]
+             606: ("_unrel_band",), 707: ("_unrel_band", "_unrel_s016")}  # 606 (session 44): the band pair only
+    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k606*.yaml")) == [
+        "lin_red_s100_p1p9_k606_unrel_band.yaml", "lin_red_s100_p7p6_k606_unrel_band.yaml"]
+    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k707*.yaml")) == sorted(
+        f"lin_red_s100_{p}_k707{tail}.yaml" for p in ("p1p9", "p7p6") for tail in ("_unrel_band", "_unrel_s016"))
     for seed in (404, 505, 606, 707):
         for p in ("1p9", "7p6"):
             for tail in tails[seed]:

@@ -61,6 +61,14 @@ def groove_geometry(case) -> dict[str, float | np.ndarray]:
     return {"profile": prof, "radius_m": radius, "centre_z_m": cutter_path(case, radius)["zc0"]}
 
 
+def cut_geometry(case) -> tuple[dict, float, float]:
+    """(:func:`groove_geometry`, the block's length [m], the contact patch's half chord [m]) of a linear cutting case."""
+    from deckgen.families import half_chord_mm
+
+    geo = groove_geometry(case)
+    return geo, case.specimen.length_mm * 1e-3, half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+
+
 def solid_in_groove(x: np.ndarray, r: np.ndarray, geo: dict, length_m: float, slice_m: float = 1e-4,
                     step_m: float = STEP_M, top_m: float | None = None, from_m: float = 0.0) -> pd.DataFrame:
     """Per slice of x along the block (``from_m``, default 0, to ``length_m``): the groove's sample points and how many
@@ -138,6 +146,11 @@ def span_weights(slices: pd.DataFrame, a: float, b: float) -> np.ndarray:
     return np.clip(np.minimum(x1, b) - np.maximum(x0, a), 0.0, None) / (x1 - x0)
 
 
+def weighted_fill(slices: pd.DataFrame, w: np.ndarray) -> float:
+    """The groove's solid fraction over the slices, each weighted by ``w`` (its share inside a range)."""
+    return float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
+
+
 def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> pd.DataFrame:
     """Per window (patch centre from lo to lo + 0.2 of the block), the groove's solid fraction and grain volume over
     each range of :data:`RANGES`, each slice weighted by the part of it inside the range (:func:`range_weights`)."""
@@ -146,7 +159,7 @@ def window_fill(slices: pd.DataFrame, length_m: float, half_chord_m: float) -> p
         row = {"patch_lo_1": lo}
         for tag in RANGES:
             w = range_weights(slices, lo, tag, length_m, half_chord_m)
-            row[f"solid_fraction_{tag}_1"] = float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
+            row[f"solid_fraction_{tag}_1"] = weighted_fill(slices, w)
             row[f"grain_volume_{tag}_mm3"] = float((w * slices["grain_volume_m3"]).sum() * 1e9)
         rows.append(row)
     return pd.DataFrame(rows)
@@ -207,14 +220,11 @@ def body_fill_at_dumps(run: Path, parsed: Path, ahead_m: float = 2e-3) -> pd.Dat
     the dump after (``force_normal_N_after``; the last dump's up to the series' end); one row per dump, the case named
     in ``case``."""
     from deckgen.chips import bond_components, initial_bonds
-    from deckgen.families import half_chord_mm
     from deckgen.parse.dump import iter_frames
 
     case, x0, r0 = load(run)
     top = float((x0[:, 2] + r0).max())
-    geo = groove_geometry(case)
-    length_m = case.specimen.length_mm * 1e-3
-    hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+    geo, length_m, hc = cut_geometry(case)
     bonds = initial_bonds(run)
     broken = pd.read_parquet(parsed / "broken.parquet", columns=["step", "id1", "id2"])
     ts = pd.read_parquet(parsed / "timeseries.parquet", columns=["step", "cutter_x_m", "force_normal_N"])
@@ -270,8 +280,7 @@ def rendered_at_dumps(slices: pd.DataFrame, dumps: pd.DataFrame, length_m: float
     def fill(a: float, b: float) -> float:
         if a < 0.0 or b > length_m:
             return float("nan")
-        w = span_weights(slices, a, b)
-        return float((w * slices["solid_points"]).sum() / (w * slices["points"]).sum())
+        return weighted_fill(slices, span_weights(slices, a, b))
 
     for mm in ahead_mm:
         out[f"solid_fraction_rendered_ahead{mm:g}mm_1"] = [fill(e, e + mm * 1e-3) for e in edge]
@@ -373,9 +382,15 @@ def load(run: Path):
     return case, raw[rock, 5:8], raw[rock, 3] / 2.0
 
 
-def main(argv: list[str] | None = None) -> int:
-    from deckgen.families import half_chord_mm
+def _load_render(run: Path):
+    """:func:`load` of a folder written by ``deckgen render``, with a clear error where it is not one."""
+    for need in ("spec.json", "specimen.data"):
+        if not (run / need).is_file():
+            raise SystemExit(f"{run}: no {need}; give a folder written by deckgen render")
+    return load(run)
 
+
+def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("runs", nargs="+", type=Path)
     ap.add_argument("--slice-mm", type=float, default=0.1)
@@ -411,17 +426,12 @@ def main(argv: list[str] | None = None) -> int:
         dumps = pd.read_csv(a.rendered_at_dumps)
         tables = []
         for run in a.runs:
-            for need in ("spec.json", "specimen.data"):
-                if not (run / need).is_file():
-                    raise SystemExit(f"{run}: no {need}; give a folder written by deckgen render")
-            case, x, r = load(run)
+            case, x, r = _load_render(run)
             mine = dumps[dumps["case"] == case.name]
             if mine.empty:
                 raise SystemExit(f"{a.rendered_at_dumps}: no dumps of {case.name} (fix: groove_fill.py --dumps on its "
                                  "run, or give its render)")
-            length_m = case.specimen.length_mm * 1e-3
-            geo = groove_geometry(case)
-            hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
+            geo, length_m, hc = cut_geometry(case)
             tables.append(rendered_at_dumps(solid_in_groove(x, r, geo, length_m, a.slice_mm * 1e-3), mine, length_m, hc))
         t = pd.concat(tables)
         with pd.option_context("display.width", 250):
@@ -431,14 +441,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     all_slices, all_windows, all_layers = [], [], []
     for run in a.runs:
-        for need in ("spec.json", "specimen.data"):
-            if not (run / need).is_file():
-                raise SystemExit(f"{run}: no {need}; give a folder written by deckgen render")
-        case, x, r = load(run)
-        length_m = case.specimen.length_mm * 1e-3
-        geo = groove_geometry(case)
+        case, x, r = _load_render(run)
+        geo, length_m, hc = cut_geometry(case)
         slices = solid_in_groove(x, r, geo, length_m, a.slice_mm * 1e-3)
-        hc = half_chord_mm(geo["radius_m"] * 1e3, case.kinematics.penetration_mm) * 1e-3
         win = window_fill(slices, length_m, hc)
         for t in (slices, win):
             t.insert(0, "penetration_mm", case.kinematics.penetration_mm)

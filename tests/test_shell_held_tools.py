@@ -176,15 +176,15 @@ def _flat(path: Path) -> dict:
     return dict(walk(yaml.safe_load(path.read_text())))
 
 
-def test_session42_to_45_cases_change_only_the_packing_seed_or_the_dumps():
+def test_session42_to_46_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),  # 505: no r 0.3 mm
-             606: ("_unrel_band",), 707: ("_unrel_band", "_unrel_s016")}  # 606 (session 44): the band pair only
-    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k606*.yaml")) == [
-        "lin_red_s100_p1p9_k606_unrel_band.yaml", "lin_red_s100_p7p6_k606_unrel_band.yaml"]
-    assert sorted(f.name for f in rec.glob("lin_red_s100_*_k707*.yaml")) == sorted(
-        f"lin_red_s100_{p}_k707{tail}.yaml" for p in ("p1p9", "p7p6") for tail in ("_unrel_band", "_unrel_s016"))
-    for seed in (404, 505, 606, 707):
+    # 505, 606, 707: no r 0.3 mm pair; 606's coarse pair added in session 46; 808 (session 46): the band pair only
+    tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),
+             606: ("_unrel_band", "_unrel_s016"), 707: ("_unrel_band", "_unrel_s016"), 808: ("_unrel_band",)}
+    for seed in (606, 707, 808):
+        assert sorted(f.name for f in rec.glob(f"lin_red_s100_*_k{seed}*.yaml")) == sorted(
+            f"lin_red_s100_{p}_k{seed}{tail}.yaml" for p in ("p1p9", "p7p6") for tail in tails[seed])
+    for seed in (404, 505, 606, 707, 808):
         for p in ("1p9", "7p6"):
             for tail in tails[seed]:
                 a = _flat(rec / f"lin_red_s100_p{p}_k{seed}{tail}.yaml")

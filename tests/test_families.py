@@ -2124,3 +2124,12 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
         [5.185, 1.637, 16.421], abs=1e-3)
     assert s7.loc["band/coarse", ["log sd between packings", "log s.e. within runs (rms)"]].tolist() == pytest.approx(
         [1.246, 0.653], abs=1e-3)
+    # the band and coarse packings of one seed are independent draws (tests/test_fine_zone.py), so band over coarse as two
+    # samples: x5.2 again, its Welch interval narrower (2.2-12.3) than the per-packing pairing's; six packings x7.8
+    u7 = mod.band_over_coarse_unpaired(packings=seven)
+    assert [u7["band packings"], u7["coarse packings"]] == [7, 7]
+    assert [u7["band/coarse"], u7["95% low"], u7["95% high"]] == pytest.approx([5.185, 2.192, 12.268], abs=1e-3)
+    assert u7["band/coarse"] == pytest.approx(s7.loc["band/coarse", "geometric mean"])  # the same packings both ways
+    assert u7["welch p"] == pytest.approx(0.00166, abs=1e-5) and u7["mann-whitney p"] == pytest.approx(14 / 3432, abs=1e-9)  # exact: 7 of 3432 splits each way
+    u6 = mod.band_over_coarse_unpaired(packings=(12345, 202, 303, 404, 505, 707))
+    assert [u6["band/coarse"], u6["95% low"], u6["95% high"]] == pytest.approx([7.827, 3.794, 16.148], abs=1e-3)

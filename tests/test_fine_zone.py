@@ -173,18 +173,24 @@ def test_the_engine_packs_a_block_with_its_band_fine_and_in_place(tmp_path):
 
 def test_a_band_and_its_plain_block_of_one_seed_are_independent_draws():
     """With one seed, a block with a band and the same block without one draw the same first radii (the band block's
-    coarse grains are the plain block's first draws), but the random stream then runs on differently (fewer coarse
-    grains, then the band's radii), so no inserted grain sits where one of the other does, even outside the band
-    (session 46: the band/coarse pairs of docs/families_runs/shell_held are two independent packings,
-    compare.band_over_coarse_unpaired)."""
+    coarse grains are the plain block's first draws), but how many radii are drawn depends on the volume they fill,
+    which the band changes, so every later draw (the band's radii, then every position) comes from a different point
+    of the random stream: no inserted grain sits where one of the other does, even outside the band, and the plain
+    block's grains lie as far from the band block's as a plain block of another seed's do (session 46: the band/coarse
+    pairs of docs/families_runs/shell_held are two independent packings, compare.band_over_coarse_unpaired)."""
     from scipy.spatial import cKDTree
 
     plain, band = load_case(TINY_CUT, LINEAR), _tiny()
+    other = load_case(TINY_CUT, {**LINEAR, "packing": {"seed": plain.packing.seed + 1}})
     assert plain.packing.seed == band.packing.seed
     x0, r0 = insert_grains(plain)
     x1, r1 = insert_grains(band)
     coarse = r1 > 0.45e-3
     assert [len(r0), coarse.sum()] == [635, 531] and np.array_equal(r1[coarse], r0[:531])
     outside = np.abs(x0[:, 1]) > 4e-3
-    d, _ = cKDTree(x1).query(x0[outside])
+    tree = cKDTree(x1)
+    d, _ = tree.query(x0[outside])
     assert outside.sum() > 100 and d.min() > 1e-5  # nowhere within 10 um
+    x2, _ = insert_grains(other)
+    d2, _ = tree.query(x2[np.abs(x2[:, 1]) > 4e-3])
+    assert np.median(d) / np.median(d2) == pytest.approx(1, abs=0.2)  # as far as another seed's grains

@@ -754,12 +754,14 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
 
 
 def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: float = 0.4,
-                              packings: tuple[int, ...] | None = None) -> dict[str, float]:
+                              packings: tuple[int, ...] | None = None) -> dict[str, float | int]:
     """Band over coarse as two independent samples (session 46): the geometric mean of the band's case-window ratios
-    over that of the coarse reference's, each over the packings that have it, with a Welch t 95 % interval and p on the
+    over that of the coarse reference's, each over the packings of :func:`packing_replicates` (those with a band pair)
+    that have it, at least two of each, with a Welch t 95 % interval and p on the
     log ratios, and a Mann-Whitney p. The band and coarse packings of one seed share the seed, not the grains (their
-    first radii are the same draws, but the stream then runs on differently, so every position differs; on the rendered
-    606 and 707 no coarse grain lies within 1 um of a band grain), so the per-packing band/coarse of :func:`packing_spread` pairs two independent draws: its
+    first radii are the same draws, but how many are drawn depends on the volume the band changes, so every later draw
+    comes from another point of the random stream; on the rendered 606 and 707 no coarse grain lies within 5 um of a band
+    grain of its seed, and the median nearest one is as far as another seed's), so the per-packing band/coarse of :func:`packing_spread` pairs two independent draws: its
     paired interval is valid but its pairing is arbitrary, and a packing without one of the two is left out there and
     kept here."""
     import numpy as np
@@ -767,8 +769,15 @@ def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: floa
 
     t = packing_replicates(width, sides, window)
     if packings is not None:
+        missing = sorted(set(packings) - set(t.index))
+        if missing:
+            raise ValueError(f"band_over_coarse_unpaired: no band pair recorded on packings {missing} at width {width} mm, "
+                             f"{sides} sides (recorded: {sorted(t.index)})")
         t = t.loc[list(packings)]
     b, c = np.log(t["band"].dropna().to_numpy(float)), np.log(t["coarse"].dropna().to_numpy(float))
+    if min(len(b), len(c)) < 2:
+        raise ValueError(f"band_over_coarse_unpaired: needs at least two packings of each (band {len(b)}, coarse "
+                         f"{len(c)})")
     welch = stats.ttest_ind(b, c, equal_var=False)
     ci = welch.confidence_interval(0.95)
     return {"band packings": len(b), "coarse packings": len(c), "band/coarse": float(np.exp(b.mean() - c.mean())),

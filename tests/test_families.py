@@ -2139,3 +2139,29 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert u7["welch p"] == pytest.approx(0.00166, abs=1e-5) and u7["mann-whitney p"] == pytest.approx(14 / 3432, abs=1e-9)  # exact: 7 of 3432 splits each way
     u6 = mod.band_over_coarse_unpaired(packings=(12345, 202, 303, 404, 505, 707))
     assert [u6["band/coarse"], u6["95% low"], u6["95% high"]] == pytest.approx([7.827, 3.794, 16.148], abs=1e-3)
+    # packing 808 (session 46, the band pair only): its deep cut weakens along the cut (107.9 -> 56.7 N) more than its
+    # shallow cut, so the case-window ratio is x0.40, the lowest of eight; over eight packings the case window is x1.25
+    # (t 95 % 0.71-2.20), six of eight above 1, and the earlier windows near 1
+    b8 = t.loc[(33, "free", 808, "band")]
+    assert [b8["grains p1p9"], b8["grains p7p6"]] == [5619, 5619]
+    assert [b8["F_n N p1p9"], b8["F_n N p7p6"]] == pytest.approx([141.742, 56.749], abs=1e-3)
+    assert [b8["largest chip grains p1p9"], b8["largest chip grains p7p6"], b8["inside p7p6"]] == [77, 21, 2]
+    assert w.loc["lin_red_s100_p1p9_k808_unrel_band"].tolist() == pytest.approx([118.562, 94.778, 72.323, 141.742], abs=1e-3)
+    assert w.loc["lin_red_s100_p7p6_k808_unrel_band"].tolist() == pytest.approx([107.915, 83.005, 52.744, 56.749],
+                                                                                abs=1e-3)
+    assert r6.loc["_k808_unrel_band"].tolist() == pytest.approx([0.910, 0.876, 0.729, 0.400], abs=1e-3)
+    assert rep6.loc[808, "band"] == pytest.approx(0.400, abs=1e-3) and rep6["band"].idxmin() == 808
+    assert np.isnan(rep6.loc[808, "coarse"])
+    s8 = mod.packing_spread()
+    assert s8["packings"].to_dict() == {"band": 8, "coarse": 7, "band/coarse": 7, "coarse r0.3": 4,
+                                        "coarse/coarse r0.3": 4}
+    assert s8.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.249, 0.708, 2.203],
+                                                                                              abs=1e-3)
+    assert s8.loc["band", ["log sd between packings", "log s.e. within runs (rms)"]].tolist() == pytest.approx(
+        [0.679, 0.426], abs=1e-3)
+    assert s8.loc[["coarse", "band/coarse"]].to_numpy() == pytest.approx(s7.loc[["coarse", "band/coarse"]].to_numpy())
+    gm8 = np.exp(np.log(r6.loc[bands + [f"_k{k}_unrel_band" for k in (606, 707, 808)]]).mean())
+    assert gm8.tolist() == pytest.approx([1.046, 0.983, 0.938, 1.249], abs=1e-3)
+    u8 = mod.band_over_coarse_unpaired()  # 808 counts in the band's sample, not in the per-packing band/coarse
+    assert [u8["band packings"], u8["coarse packings"]] == [8, 7]
+    assert [u8["band/coarse"], u8["95% low"], u8["95% high"]] == pytest.approx([4.408, 1.806, 10.755], abs=1e-3)

@@ -495,19 +495,20 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
     both fills' (predicted before its run). On 606 (session 44) the two fills disagree: the touched range's order
     (registered as the prediction) came out reversed, the leading edge's exactly; over six packings the leading edge's
     fill is the link that holds, with or without the window means. On 707 (session 45) the leading edge's order was
-    registered and F_n came out in its exact reverse; over seven packings its within-run link is 0.49. The deep cut
-    shows none."""
+    registered and F_n came out in its exact reverse; over seven packings its within-run link is 0.49. On 808 (session
+    46) it ranks at 0.2 (0.45 over eight). The deep cut shows none."""
     mod = load_script(HELD / "groove_fill.py")
     fill = pd.read_csv(HELD / "groove_fill_windows.csv")
     windows = pd.read_csv(HELD / "linear_grain_pair_windows.csv")
     band = fill[fill["case"].str.endswith("_band")]
-    assert sorted(set(band["packing_seed"])) == [202, 303, 404, 505, 606, 707, 12345] and len(band) == 56
+    assert sorted(set(band["packing_seed"])) == [202, 303, 404, 505, 606, 707, 808, 12345] and len(band) == 64
     shallow, deep = 0.95, 3.8
-    a5 = mod.against_forces(band[~band["packing_seed"].isin([606, 707])], windows).set_index(
+    a5 = mod.against_forces(band[~band["packing_seed"].isin([606, 707, 808])], windows).set_index(
         ["penetration_mm", "fill", "how"])
     assert a5.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
         [0.800, 0.00089], abs=1e-5)
-    a = mod.against_forces(band[band["packing_seed"] != 707], windows).set_index(["penetration_mm", "fill", "how"])
+    a = mod.against_forces(band[~band["packing_seed"].isin([707, 808])], windows).set_index(
+        ["penetration_mm", "fill", "how"])
     assert a.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
         [0.7333, 0.0010], abs=1e-4)
     assert a.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.716, abs=1e-3)
@@ -522,7 +523,8 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
     for seed, orders, fn_order in (
             (505, {"touched": [0.4, 0.3, 0.1, 0.2], "front": [0.4, 0.3, 0.1, 0.2]}, [0.4, 0.3, 0.1, 0.2]),
             (606, {"touched": [0.1, 0.2, 0.3, 0.4], "front": [0.4, 0.3, 0.2, 0.1]}, [0.4, 0.3, 0.2, 0.1]),
-            (707, {"touched": [0.4, 0.3, 0.2, 0.1], "front": [0.3, 0.2, 0.4, 0.1]}, [0.1, 0.4, 0.2, 0.3])):
+            (707, {"touched": [0.4, 0.3, 0.2, 0.1], "front": [0.3, 0.2, 0.4, 0.1]}, [0.1, 0.4, 0.2, 0.3]),
+            (808, {"touched": [0.2, 0.1, 0.4, 0.3], "front": [0.2, 0.1, 0.4, 0.3]}, [0.4, 0.1, 0.2, 0.3])):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
         f = band[band["case"] == name].set_index("patch_lo_1")
         for tag, order in orders.items():
@@ -531,7 +533,7 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
         assert fn.sort_values(ascending=False).index.tolist() == fn_order
     # seven packings: the leading edge's within-run link falls to 0.49 (p 0.029), two-way 0.41; the touched range's
     # 0.37 (p 0.10); the deep cut still none
-    a7 = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
+    a7 = mod.against_forces(band[band["packing_seed"] != 808], windows).set_index(["penetration_mm", "fill", "how"])
     assert a7.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
         [0.4857, 0.0289], abs=1e-4)
     assert a7.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.408, abs=1e-3)
@@ -539,6 +541,14 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
         [0.3714, 0.1017], abs=1e-4)
     for tag in mod.RANGES:
         assert abs(a7.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
+    # eight packings (808, session 46: F_n 0.4 > 0.1 > 0.2 > 0.3 against the leading edge's 0.2 > 0.1 > 0.4 > 0.3,
+    # rho 0.2): the leading edge's within-run link 0.45 (p 0.030), the touched range's 0.35 (p 0.098)
+    a8 = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
+    assert a8.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
+        [0.4500, 0.0302], abs=2e-3)
+    assert a8.loc[(shallow, "solid_fraction_touched_1", "within-run"), "spearman_rho_1"] == pytest.approx(0.35, abs=1e-4)
+    for tag in mod.RANGES:
+        assert abs(a8.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
 
 
 def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
@@ -548,18 +558,24 @@ def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
     lay = pd.read_csv(HELD / "groove_fill_layers.csv")
     fill = pd.read_csv(HELD / "groove_fill_windows.csv")
     windows = pd.read_csv(HELD / "linear_grain_pair_windows.csv")[["case", "patch_lo_1", "force_normal_N_mean_steady"]]
-    assert sorted(set(lay["packing_seed"])) == [202, 303, 404, 505, 606, 707, 12345] and (lay["penetration_mm"] == 0.95).all()
+    assert sorted(set(lay["packing_seed"])) == [202, 303, 404, 505, 606, 707, 808, 12345]
+    assert (lay["penetration_mm"] == 0.95).all()
     pooled = lay.assign(s=lay["solid_fraction_1"] * lay["points"]).groupby(["case", "patch_lo_1"])[["s", "points"]].sum()
     whole = fill.set_index(["case", "patch_lo_1"]).loc[pooled.index, "solid_fraction_touched_1"]
     assert (pooled["s"] / pooled["points"]).to_numpy() == pytest.approx(whole.to_numpy(), abs=2e-6)  # CSV rounding
-    five = lay[~lay["packing_seed"].isin([606, 707])].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+    five = lay[~lay["packing_seed"].isin([606, 707, 808])].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
     rho = {lo: np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
                         for _, g in by.groupby("case")]) for lo, by in five.groupby("layer_lo_mm")}
     assert list(rho) == [0.0, 0.2, 0.4, 0.6, 0.8]
     assert list(rho.values()) == pytest.approx([0.12, 0.32, 0.48, 0.40, 0.44], abs=1e-9)
     assert max(rho.values()) < 0.8 and min(rho, key=rho.get) == 0.0
     # seven packings (606, 707 added): no layer links (707's layers all rank against its F_n, -0.4 to -1)
-    seven = lay.merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+    seven = lay[lay["packing_seed"] != 808].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
     rho7 = [np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
                      for _, g in by.groupby("case")]) for _, by in seven.groupby("layer_lo_mm")]
     assert rho7 == pytest.approx([0.086, 0.200, 0.114, 0.0, 0.029], abs=1e-3)
+    # eight packings (808, session 46): still none
+    eight = lay.merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+    rho8 = [np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
+                     for _, g in by.groupby("case")]) for _, by in eight.groupby("layer_lo_mm")]
+    assert rho8 == pytest.approx([0.125, 0.275, 0.0, -0.075, 0.025], abs=1e-3)

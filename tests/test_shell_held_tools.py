@@ -467,18 +467,22 @@ def test_recorded_dumps_of_606_load_up_to_a_break_and_the_local_rock_does_not_ra
     assert pt.loc[pt["largest_piece_grains"] == 39, "patch_centre_1"].iloc[0] == pytest.approx(0.53, abs=0.01)
     links = mod.dump_links(d[d["patch_centre_1"] > 0.05]).set_index(["case", "fill"])["spearman_rho_1"]
     # 707 (session 45, its 55 dumps): the crushed rock under the disc ranks again (0.65), the rock ahead against F_n
-    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186), (707, 0.652, -0.371)):
+    # 808 (session 46, its 55 dumps): under the disc 0.58 again, ahead 0.26
+    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186), (707, 0.652, -0.371), (808, 0.583, 0.260)):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
         assert links[(name, "solid_fraction_all_under_1")] == pytest.approx(under, abs=1e-3)
         assert links[(name, "solid_fraction_all_ahead_1")] == pytest.approx(ahead, abs=1e-3)
     r = pd.read_csv(HELD / "groove_fill_rendered_at_dumps.csv")
-    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606, 707)]
+    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606, 707, 808)]
     rl = mod.dump_links(r).set_index(["case", "fill"])["spearman_rho_1"]
     got = {k: [rl[(f"lin_red_s100_p1p9_k{k}_unrel_band", f"solid_fraction_rendered_ahead{a}mm_1")] for a in (1, 2, 5, 10)]
-           for k in (505, 606, 707)}
+           for k in (505, 606, 707, 808)}
     assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.234], abs=1e-3)
     assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.655], abs=1e-3)
     assert got[707] == pytest.approx([-0.239, -0.484, -0.482, -0.355], abs=1e-3)
+    assert got[808] == pytest.approx([0.460, 0.323, 0.321, -0.198], abs=1e-3)  # session 46
+    k8 = d[d["case"] == "lin_red_s100_p1p9_k808_unrel_band"]
+    assert k8["step"].tolist() == list(range(0, 540001, 10000))
     k6r = r[r["case"] == "lin_red_s100_p1p9_k606_unrel_band"]
     assert len(k6r) == 41 and k6r["solid_fraction_rendered_ahead10mm_1"].notna().sum() == 32
     # the rendered rows are the dumps' own (same steps, patch centres and F_n)

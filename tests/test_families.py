@@ -2067,8 +2067,8 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
     assert s6.loc["band", "log sd between packings"] > s6.loc["band", "log s.e. within runs (rms)"]
     gm6 = np.exp(np.log(r6.loc[bands + ["_k606_unrel_band"]]).mean())
     assert gm6.tolist() == pytest.approx([1.159, 1.006, 0.929, 1.480], abs=1e-3)
-    # packing 707 (session 45, the band pair only): its shallow cut is strongest in window 0.1 (a 70-grain piece breaks
-    # off at patch 0.245, the largest of the band runs) and its deep cut rises along the cut, so the ratio rises from
+    # packing 707 (session 45, the band pair only): its shallow cut is strongest in window 0.1 (a 70-grain piece, 69 at the end, breaks
+    # off at patch 0.245, the largest of the band runs until 808) and its deep cut rises along the cut, so the ratio rises from
     # x0.65 to x1.40; over seven packings the case window is x1.47 (t 95 % 0.89-2.42, holding 1) and the earlier
     # windows near 1
     b7 = t.loc[(33, "free", 707, "band")]

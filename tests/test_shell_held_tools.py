@@ -550,26 +550,19 @@ def test_recorded_band_windows_rank_with_the_groove_fill():
         fn = windows[windows["case"] == name].set_index("patch_lo_1")["force_normal_N_mean_steady"]
         assert fn.sort_values(ascending=False).index.tolist() == fn_order
     # seven packings: the leading edge's within-run link falls to 0.49 (p 0.029), two-way 0.41; the touched range's
-    # 0.37 (p 0.10); the deep cut still none
-    a7 = mod.against_forces(band[band["packing_seed"] != 808], windows).set_index(["penetration_mm", "fill", "how"])
-    assert a7.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
-        [0.4857, 0.0289], abs=1e-4)
-    assert a7.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.408, abs=1e-3)
-    assert a7.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
-        [0.3714, 0.1017], abs=1e-4)
-    for tag in mod.RANGES:
-        assert abs(a7.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
-    # eight packings (808, session 46: F_n 0.4 > 0.1 > 0.2 > 0.3 against the leading edge's 0.2 > 0.1 > 0.4 > 0.3,
-    # rho 0.2): the leading edge's within-run link 0.45 (p 0.030), the touched range's 0.35 (p 0.098)
-    a8 = mod.against_forces(band, windows).set_index(["penetration_mm", "fill", "how"])
-    assert a8.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
-        [0.4500, 0.0302], abs=1e-4)
-    assert a8.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(0.431, abs=1e-3)
-    assert a8.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == pytest.approx(
-        [0.3500, 0.0983], abs=1e-4)
-    for tag in mod.RANGES:
-        assert abs(a8.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
-
+    # 0.37 (p 0.10); the deep cut still none. Eight packings (808, session 46: F_n 0.4 > 0.1 > 0.2 > 0.3 against the
+    # leading edge's 0.2 > 0.1 > 0.4 > 0.3, rho 0.2): the leading edge's within-run link 0.45 (p 0.030), two-way 0.43,
+    # the touched range's 0.35 (p 0.098)
+    for runs, front, two_way, touched in ((band[band["packing_seed"] != 808], [0.4857, 0.0289], 0.408, [0.3714, 0.1017]),
+                                          (band, [0.4500, 0.0302], 0.431, [0.3500, 0.0983])):
+        an = mod.against_forces(runs, windows).set_index(["penetration_mm", "fill", "how"])
+        assert an.loc[(shallow, "solid_fraction_front_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == (
+            pytest.approx(front, abs=1e-4))
+        assert an.loc[(shallow, "solid_fraction_front_1", "two-way"), "spearman_rho_1"] == pytest.approx(two_way, abs=1e-3)
+        assert an.loc[(shallow, "solid_fraction_touched_1", "within-run"), ["spearman_rho_1", "p_1"]].tolist() == (
+            pytest.approx(touched, abs=1e-4))
+        for tag in mod.RANGES:
+            assert abs(an.loc[(deep, f"solid_fraction_{tag}_1", "within-run"), "spearman_rho_1"]) < 0.3
 
 def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
     """docs/families_runs/shell_held/groove_fill_layers.csv (groove_fill.py --layers-out, session 44): over the five
@@ -583,19 +576,17 @@ def test_recorded_layers_above_the_tip_do_not_carry_the_fill_link():
     pooled = lay.assign(s=lay["solid_fraction_1"] * lay["points"]).groupby(["case", "patch_lo_1"])[["s", "points"]].sum()
     whole = fill.set_index(["case", "patch_lo_1"]).loc[pooled.index, "solid_fraction_touched_1"]
     assert (pooled["s"] / pooled["points"]).to_numpy() == pytest.approx(whole.to_numpy(), abs=2e-6)  # CSV rounding
-    five = lay[~lay["packing_seed"].isin([606, 707, 808])].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
-    rho = {lo: np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
-                        for _, g in by.groupby("case")]) for lo, by in five.groupby("layer_lo_mm")}
+
+    def layer_rho(seeds_left_out: list[int]) -> dict[float, float]:  # per layer: the mean of the runs' own rho with F_n
+        m = lay[~lay["packing_seed"].isin(seeds_left_out)].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
+        return {lo: np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
+                             for _, g in by.groupby("case")]) for lo, by in m.groupby("layer_lo_mm")}
+
+    rho = layer_rho([606, 707, 808])
     assert list(rho) == [0.0, 0.2, 0.4, 0.6, 0.8]
     assert list(rho.values()) == pytest.approx([0.12, 0.32, 0.48, 0.40, 0.44], abs=1e-9)
     assert max(rho.values()) < 0.8 and min(rho, key=rho.get) == 0.0
     # seven packings (606, 707 added): no layer links (707's layers all rank against its F_n, -0.4 to -1)
-    seven = lay[lay["packing_seed"] != 808].merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
-    rho7 = [np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
-                     for _, g in by.groupby("case")]) for _, by in seven.groupby("layer_lo_mm")]
-    assert rho7 == pytest.approx([0.086, 0.200, 0.114, 0.0, 0.029], abs=1e-3)
+    assert list(layer_rho([808]).values()) == pytest.approx([0.086, 0.200, 0.114, 0.0, 0.029], abs=1e-3)
     # eight packings (808, session 46): still none
-    eight = lay.merge(windows, on=["case", "patch_lo_1"], validate="many_to_one")
-    rho8 = [np.mean([g["solid_fraction_1"].corr(g["force_normal_N_mean_steady"], method="spearman")
-                     for _, g in by.groupby("case")]) for _, by in eight.groupby("layer_lo_mm")]
-    assert rho8 == pytest.approx([0.125, 0.275, 0.0, -0.075, 0.025], abs=1e-3)
+    assert list(layer_rho([]).values()) == pytest.approx([0.125, 0.275, 0.0, -0.075, 0.025], abs=1e-3)

@@ -2116,7 +2116,7 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
                                                                                 abs=1e-3)
     assert r6.loc["_k606_unrel_s016"].tolist() == pytest.approx([2.050, 0.515, 0.128, 1.102], abs=1e-3)
     assert rep6.loc[606, ["coarse", "band/coarse"]].tolist() == pytest.approx([1.102, 0.438], abs=1e-3)
-    assert rep6["coarse"].idxmax() == 606 and rep6["band/coarse"].dropna().lt(1).sum() == 1
+    assert rep6["coarse"].idxmax() == 606 and rep6.loc[list(seven), "band/coarse"].lt(1).sum() == 1  # 808: session 47
     assert s7["packings"].to_dict() == {"band": 7, "coarse": 7, "band/coarse": 7, "coarse r0.3": 4,
                                         "coarse/coarse r0.3": 4}
     assert s7.loc["coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([0.283, 0.127, 0.633],
@@ -2151,17 +2151,99 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
                                                                                 abs=1e-3)
     assert r6.loc["_k808_unrel_band"].tolist() == pytest.approx([0.910, 0.876, 0.729, 0.400], abs=1e-3)
     assert rep6.loc[808, "band"] == pytest.approx(0.400, abs=1e-3) and rep6["band"].idxmin() == 808
-    assert np.isnan(rep6.loc[808, "coarse"])
-    s8 = mod.packing_spread()
-    assert s8["packings"].to_dict() == {"band": 8, "coarse": 7, "band/coarse": 7, "coarse r0.3": 4,
-                                        "coarse/coarse r0.3": 4}
+    eight = seven + (808,)
+    s8 = mod.packing_spread(packings=eight)
+    assert s8["packings"].to_dict() == {"band": 8, "coarse": 8, "band/coarse": 8, "coarse r0.3": 4,  # 808's coarse:
+                                        "coarse/coarse r0.3": 4}  # session 47, below
     assert s8.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.249, 0.708, 2.203],
                                                                                               abs=1e-3)
     assert s8.loc["band", ["log sd between packings", "log s.e. within runs (rms)"]].tolist() == pytest.approx(
         [0.679, 0.426], abs=1e-3)
-    assert s8.loc[["coarse", "band/coarse"]].to_numpy() == pytest.approx(s7.loc[["coarse", "band/coarse"]].to_numpy())
     gm8 = np.exp(np.log(r6.loc[bands + [f"_k{k}_unrel_band" for k in (606, 707, 808)]]).mean())
     assert gm8.tolist() == pytest.approx([1.046, 0.983, 0.938, 1.249], abs=1e-3)
-    u8 = mod.band_over_coarse_unpaired()  # 808 counts in the band's sample, not in the per-packing band/coarse
-    assert [u8["band packings"], u8["coarse packings"]] == [8, 7]
-    assert [u8["band/coarse"], u8["95% low"], u8["95% high"]] == pytest.approx([4.408, 1.806, 10.755], abs=1e-3)
+    from scipy import stats
+
+    # session 46's unpaired reading, 808's band in the band's sample before its coarse pair ran (session 47)
+    u8 = mod.band_over_coarse_unpaired(packings=seven)
+    b8s = np.log(rep6.loc[list(eight), "band"].to_numpy(float))
+    c7s = np.log(rep6.loc[list(seven), "coarse"].to_numpy(float))
+    assert np.exp(b8s.mean() - c7s.mean()) == pytest.approx(4.408, abs=1e-3)
+    welch = stats.ttest_ind(b8s, c7s, equal_var=False)
+    ci = welch.confidence_interval(0.95)
+    assert [np.exp(ci.low), np.exp(ci.high)] == pytest.approx([1.806, 10.755], abs=1e-3)
+    assert welch.pvalue == pytest.approx(0.00366, abs=1e-5)
+    assert u8["band/coarse"] == pytest.approx(5.185, abs=1e-3)
+
+
+def test_808_coarse_reference_and_two_stretches_of_one_cut():
+    """Session 47: packing 808's coarse r 0.16 mm reference (docs/families.md, "The cutter shell held in y", its
+    session-47 part) and the case window read beside a second stretch of the same cut (compare.two_window_ratios:
+    patch 0.1-0.3 and 0.4-0.6 as one 10.4 mm stretch). 808's coarse ratio falls (x0.52) while its deep cut splits a
+    392-grain side off the block; over eight packings the coarse case window stays below 1 and band over coarse above it.
+    Within a band run the two stretches' ratios do not go together between packings (correlation -0.35), so the
+    spread of the stretch ratio between packings is about half the case window's and its interval is narrower."""
+    from scipy import stats
+
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k808_unrel_s016.yaml",
+                                   rec / f"lin_red_s100_p{p}_unrel_s016.yaml") == {("packing", "seed"): (808, None)}
+    t = mod.grain_pairs()
+    c8 = t.loc[(33, "free", 808, "coarse")]
+    assert [c8["grains p1p9"], c8["grains p7p6"]] == [2476, 2476]
+    assert [c8["F_n N p1p9"], c8["F_n N p7p6"]] == pytest.approx([293.844, 153.161], abs=1e-3)
+    assert [c8["largest chip grains p1p9"], c8["largest chip grains p7p6"]] == [4, 392]  # a side splits off the deep cut
+    assert [c8["inside p1p9"], c8["inside p7p6"]] == [0, 0]
+    w = mod.grain_pair_windows()
+    assert w.loc["lin_red_s100_p1p9_k808_unrel_s016"].tolist() == pytest.approx([194.130, 241.050, 233.493, 293.844],
+                                                                                abs=1e-3)
+    assert w.loc["lin_red_s100_p7p6_k808_unrel_s016"].tolist() == pytest.approx([102.892, 142.113, 231.419, 153.161],
+                                                                                abs=1e-3)
+    rep = mod.packing_replicates()
+    assert rep.loc[808, ["coarse", "coarse s.e.", "band/coarse"]].tolist() == pytest.approx([0.521, 0.281, 0.768],
+                                                                                             abs=1e-3)
+    assert sorted(rep.index[rep["band/coarse"] < 1]) == [606, 808]  # the two packings with the lowest band ratios
+    eight = (12345, 202, 303, 404, 505, 606, 707, 808)
+    s8 = mod.packing_spread(packings=eight)
+    assert s8.loc["coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([0.306, 0.152, 0.613],
+                                                                                                abs=1e-3)
+    assert s8.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(
+        [4.084, 1.336, 12.489], abs=1e-3)
+    u8 = mod.band_over_coarse_unpaired(packings=eight)
+    assert [u8["band packings"], u8["coarse packings"]] == [8, 8]
+    assert [u8["band/coarse"], u8["95% low"], u8["95% high"]] == pytest.approx([4.084, 1.802, 9.255], abs=1e-3)
+    assert u8["welch p"] == pytest.approx(0.00251, abs=1e-5)
+    # two stretches of one cut: each run's F_n is the rows-weighted mean of windows 0.1 and 0.4 (recomputed here from
+    # the recorded windows), the ratio of the two runs' stretch means
+    raw = mod.pd.read_csv(mod.PAIR_WINDOWS_CSV).set_index(["case", "patch_lo_1"])
+
+    def stretch(case: str) -> float:
+        r = raw.loc[[(case, 0.1), (case, 0.4)]]
+        return float((r["force_normal_N_mean_steady"] * r["rows"]).sum() / r["rows"].sum())
+
+    two = mod.two_window_ratios()
+    for k, tail in ((808, "_k808_unrel_band"), (808, "_k808_unrel_s016"), (12345, "_unrel_band")):
+        size = "band" if tail.endswith("band") else "coarse"
+        assert two.loc[k, size] == pytest.approx(stretch(f"lin_red_s100_p7p6{tail}") / stretch(f"lin_red_s100_p1p9{tail}"))
+    assert two.loc[list(eight), "band"].tolist() == pytest.approx(
+        [0.902, 1.848, 1.495, 1.322, 1.518, 0.935, 0.972, 0.633], abs=1e-3)
+    sp = mod.two_window_spread(packings=eight)
+    assert sp.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.141, 0.849, 1.534],
+                                                                                              abs=1e-3)
+    # the band's stretch spread is about half the case window's (0.68); its window correlation is negative (not
+    # significant: n 8), the coarse reference's positive (its 303 is low all along the cut)
+    assert sp.loc["band", ["log sd between packings", "log sd window 0.1", "log sd window 0.4"]].tolist() == pytest.approx(
+        [0.354, 0.547, 0.679], abs=1e-3)
+    assert sp.loc["band", "window corr"] == pytest.approx(-0.354, abs=1e-3) and sp.loc["band", "window corr p"] > 0.3
+    assert sp.loc["coarse", ["geometric mean", "95% low", "95% high", "window corr"]].tolist() == pytest.approx(
+        [0.522, 0.303, 0.899, 0.334], abs=1e-3)
+    # the stretch's interval excludes the seed's x1.76 (seed 001, p 7.6 over 1.9 mm at S 100 mm) where the case
+    # window's (0.71-2.20) holds it; a reading picked after the eight packings were seen (session 47)
+    assert sp.loc["band", "95% high"] < 1.76 < s8.loc["band", "95% high"]
+    lg = np.log(two.loc[list(eight), "band"].to_numpy(float))
+    assert sp.loc["band", "t p"] == pytest.approx(stats.ttest_1samp(lg, 0.0).pvalue)
+    with pytest.raises(ValueError, match="at least 0.2 apart"):
+        mod.two_window_ratios(windows=(0.1, 0.2))
+    with pytest.raises(ValueError, match=r"no band pair recorded on packings \[999\]"):
+        mod.two_window_spread(packings=(12345, 999))

@@ -82,7 +82,7 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: reference with the same r 0.16 mm shell (``_s016``; session 35's ``_unrel`` runs have the r 0.3 mm shell), on
 #: packings 12345 and 202 (one report per grain size holds both), 303 (session 41), 404 (session 42; not a family
 #: packing: add_packing.py), 505 (session 43, no r 0.3 mm pair), 606 (session 44, the band pair; its coarse reference
-#: session 46; no r 0.3 mm pair), 707 (session 45, no r 0.3 mm pair) and 808 (session 46, the band pair only)
+#: session 46; no r 0.3 mm pair), 707 (session 45, no r 0.3 mm pair) and 808 (session 46, the band pair; its coarse reference session 47; no r 0.3 mm pair)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -104,7 +104,8 @@ GRAIN_PAIRS = {
                         "band": ("_k606_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 707): {"coarse": ("_k707_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k707_unrel_band", HERE / "linear_unrel_band")},
-    (33, "free", 808): {"band": ("_k808_unrel_band", HERE / "linear_unrel_band")}}
+    (33, "free", 808): {"coarse": ("_k808_unrel_s016", HERE / "linear_unrel_s016"),
+                        "band": ("_k808_unrel_band", HERE / "linear_unrel_band")}}
 #: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
 #: 35, 41 and 42), per :data:`GRAIN_PAIRS` key: the shell-radius reference of :func:`packing_replicates`
 SHELL03_TAILS = {(33, "free", 12345): "_unrel", (33, "free", 202): "_k202_unrel", (33, "free", 303): "_k303_unrel",
@@ -703,7 +704,7 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
         row = {"packing": packing}
 
         def put(col: str, t: str | None) -> None:  # the pair's ratio and error, NaN where it was not run
-            has = t in ratios.index  # 505, 606, 707, 808: no r 0.3 mm pair; 808: no coarse pair
+            has = t in ratios.index  # 505, 606, 707, 808: no r 0.3 mm pair
             row[col] = ratios.loc[t, window] if has else float("nan")
             row[f"{col} s.e."] = errors.loc[t, window] if has else float("nan")
 
@@ -738,7 +739,7 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
     rel["coarse/coarse r0.3"] = np.hypot(rel["coarse"], rel["coarse r0.3"])
     rows = []
     for col in ("band", "coarse", "band/coarse", "coarse r0.3", "coarse/coarse r0.3"):
-        ok = t[col].notna()  # no r 0.3 mm shell pair on 505 / 606 / 707 / 808, no coarse pair on 808 (sessions 43-46)
+        ok = t[col].notna()  # no r 0.3 mm shell pair on 505 / 606 / 707 / 808 (sessions 43-47)
         if ok.sum() < 2:
             continue
         lg = np.log(t.loc[ok, col].to_numpy(dtype=float))
@@ -752,6 +753,18 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
                      "log sd between packings": sd, "log s.e. within runs (rms)": float(np.sqrt((rc ** 2).mean())),
                      "95% low within": np.exp(lg.mean() - within), "95% high within": np.exp(lg.mean() + within)})
     return pd.DataFrame(rows).set_index("ratio")
+
+
+def _only_packings(t: pd.DataFrame, packings: tuple[int, ...] | None, who: str, width: int, sides: str) -> pd.DataFrame:
+    """The rows of a per-packing table ``t`` for ``packings`` (all where None); a packing without a recorded band pair
+    is refused with the recorded ones named."""
+    if packings is None:
+        return t
+    missing = sorted(set(packings) - set(t.index))
+    if missing:
+        raise ValueError(f"{who}: no band pair recorded on packings {missing} at width {width} mm, {sides} sides "
+                         f"(recorded: {sorted(t.index)})")
+    return t.loc[list(packings)]
 
 
 def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: float = 0.4,
@@ -768,13 +781,7 @@ def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: floa
     import numpy as np
     from scipy import stats
 
-    t = packing_replicates(width, sides, window)
-    if packings is not None:
-        missing = sorted(set(packings) - set(t.index))
-        if missing:
-            raise ValueError(f"band_over_coarse_unpaired: no band pair recorded on packings {missing} at width {width} mm, "
-                             f"{sides} sides (recorded: {sorted(t.index)})")
-        t = t.loc[list(packings)]
+    t = _only_packings(packing_replicates(width, sides, window), packings, "band_over_coarse_unpaired", width, sides)
     b, c = np.log(t["band"].dropna().to_numpy(float)), np.log(t["coarse"].dropna().to_numpy(float))
     if min(len(b), len(c)) < 2:
         raise ValueError(f"band_over_coarse_unpaired: needs at least two packings of each (band {len(b)}, coarse "
@@ -785,6 +792,73 @@ def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: floa
             "95% low": float(np.exp(ci.low)), "95% high": float(np.exp(ci.high)), "welch dof": float(welch.df),
             "welch p": float(welch.pvalue),
             "mann-whitney p": float(stats.mannwhitneyu(b, c, alternative="two-sided").pvalue)}
+
+
+def two_window_ratios(width: int = 33, sides: str = "free", windows: tuple[float, ...] = (0.1, 0.4)) -> pd.DataFrame:
+    """Session 47: per packing of :func:`packing_replicates` (index), F_n p 7.6 / 1.9 mm of the ``band`` and ``coarse``
+    pairs over several non-overlapping windows of :data:`PATCH_WINDOWS` read as one stretch of the cut: each run's F_n
+    is the mean over the windows weighted by their rows (for (0.1, 0.4), the contact patch over 0.1-0.3 and 0.4-0.6 of
+    the block, 10.4 mm of the 26 mm block; the 0.3-0.4 stretch between them has no window of its own). What a run
+    over a longer block would average, if the rock of one stretch does not tell the next (:func:`two_window_spread`
+    checks that). NaN where a pair was not run."""
+    import numpy as np
+
+    lo = sorted(windows)
+    if any(w not in PATCH_WINDOWS for w in lo) or any(b - a < 0.2 - 1e-9 for a, b in zip(lo, lo[1:])):
+        raise ValueError(f"two_window_ratios: windows {windows} must be starts of PATCH_WINDOWS {PATCH_WINDOWS} at least "
+                         "0.2 apart (each window spans 0.2 of the block; overlapping windows count rock twice)")
+    w = pd.read_csv(PAIR_WINDOWS_CSV)
+    w = w[w["patch_lo_1"].isin(lo)].assign(weighted=lambda d: d["force_normal_N_mean_steady"] * d["rows"])
+    g = w.groupby("case")
+    fn = g["weighted"].sum() / g["rows"].sum()
+    whole = g["patch_lo_1"].count() == len(lo)  # a run that does not finish one of the windows has no stretch mean
+    fn = fn[whole]
+    rows = []
+    for packing in packing_replicates(width, sides).index:
+        sizes = GRAIN_PAIRS[(width, sides, packing)]
+        row = {"packing": packing}
+        for size in ("band", "coarse"):
+            tail = sizes.get(size, (None,))[0]
+            a, b = f"lin_red_s100_p7p6{tail}", f"lin_red_s100_p1p9{tail}"
+            row[size] = fn[a] / fn[b] if tail and a in fn.index and b in fn.index else np.nan
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("packing")
+
+
+def two_window_spread(width: int = 33, sides: str = "free", windows: tuple[float, float] = (0.1, 0.4),
+                      packings: tuple[int, ...] | None = None) -> pd.DataFrame:
+    """Session 47: for ``band`` and ``coarse`` (rows), over the packings that have the pair (at least three): the
+    geometric mean of :func:`two_window_ratios` with its Student t 95 % interval and the log sd between packings, beside
+    the same for each single window (``log sd window 0.1`` ...), and the Pearson correlation between packings of the
+    two windows' log ratios (``window corr``, its two-sided ``window corr p``). A correlation near 0 or below says the
+    rock of one stretch of a run does not tell the next, so averaging more of the cut narrows the spread between
+    packings (for two independent windows of equal spread, by sqrt 2); a correlation near 1 says a packing's ratio is
+    its own, and a longer cut would not help."""
+    import numpy as np
+    from scipy import stats
+
+    if len(windows) != 2:
+        raise ValueError(f"two_window_spread: give two windows (got {windows})")
+    both = _only_packings(two_window_ratios(width, sides, windows), packings, "two_window_spread", width, sides)
+    per_window = {w: packing_replicates(width, sides, w) for w in windows}
+    rows = []
+    for size in ("band", "coarse"):
+        ok = both[size].dropna().index
+        if len(ok) < 3:
+            continue
+        lg = np.log(both.loc[ok, size].to_numpy(float))
+        n = len(lg)
+        half = stats.t.ppf(0.975, n - 1) * lg.std(ddof=1) / np.sqrt(n)
+        lw = [np.log(per_window[w].loc[ok, size].to_numpy(float)) for w in windows]
+        r = stats.pearsonr(lw[0], lw[1])
+        row = {"size": size, "packings": n, "geometric mean": float(np.exp(lg.mean())),
+               "95% low": float(np.exp(lg.mean() - half)), "95% high": float(np.exp(lg.mean() + half)),
+               "t p": float(stats.ttest_1samp(lg, 0.0).pvalue), "log sd between packings": float(lg.std(ddof=1))}
+        for w, l in zip(windows, lw):
+            row[f"log sd window {w}"] = float(l.std(ddof=1))
+        row["window corr"], row["window corr p"] = float(r.statistic), float(r.pvalue)
+        rows.append(row)
+    return pd.DataFrame(rows).set_index("size")
 
 
 def main() -> None:

@@ -2178,7 +2178,7 @@ def test_33mm_block_with_a_fine_band_along_the_cut_does_not_fall_with_p_where_it
 def test_808_coarse_reference_and_two_stretches_of_one_cut():
     """Session 47: packing 808's coarse r 0.16 mm reference (docs/families.md, "The cutter shell held in y", its
     session-47 part) and the case window read beside a second stretch of the same cut (compare.two_window_ratios:
-    patch 0.1-0.3 and 0.4-0.6 as one 10.4 mm stretch). 808's coarse ratio falls (x0.52) while its deep cut splits a
+    patch 0.1-0.3 and 0.4-0.6, or 0.2-0.6 where the deep cut has left the entry face, as one 10.4 mm stretch). 808's coarse ratio falls (x0.52) while its deep cut splits a
     392-grain side off the block; over eight packings the coarse case window stays below 1 and band over coarse above it.
     Within a band run the two stretches' ratios do not go together between packings (correlation -0.35), so the
     spread of the stretch ratio between packings is about half the case window's and its interval is narrower."""
@@ -2222,13 +2222,13 @@ def test_808_coarse_reference_and_two_stretches_of_one_cut():
         r = raw.loc[[(case, 0.1), (case, 0.4)]]
         return float((r["force_normal_N_mean_steady"] * r["rows"]).sum() / r["rows"].sum())
 
-    two = mod.two_window_ratios()
+    two = mod.two_window_ratios(windows=(0.1, 0.4))
     for k, tail in ((808, "_k808_unrel_band"), (808, "_k808_unrel_s016"), (12345, "_unrel_band")):
         size = "band" if tail.endswith("band") else "coarse"
         assert two.loc[k, size] == pytest.approx(stretch(f"lin_red_s100_p7p6{tail}") / stretch(f"lin_red_s100_p1p9{tail}"))
     assert two.loc[list(eight), "band"].tolist() == pytest.approx(
         [0.902, 1.848, 1.495, 1.322, 1.518, 0.935, 0.972, 0.633], abs=1e-3)
-    sp = mod.two_window_spread(packings=eight)
+    sp = mod.two_window_spread(windows=(0.1, 0.4), packings=eight)
     assert sp.loc["band", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([1.141, 0.849, 1.534],
                                                                                               abs=1e-3)
     # the band's stretch spread is about half the case window's (0.68); its window correlation is negative (not
@@ -2243,6 +2243,17 @@ def test_808_coarse_reference_and_two_stretches_of_one_cut():
     assert sp.loc["band", "95% high"] < 1.76 < s8.loc["band", "95% high"]
     lg = np.log(two.loc[list(eight), "band"].to_numpy(float))
     assert sp.loc["band", "t p"] == pytest.approx(stats.ttest_1samp(lg, 0.0).pvalue)
+    # but the deep cut's contact arc lies whole inside the block only from patch 0.266 (0.136 for the shallow cut), so its
+    # window 0.1 is mostly entry; the engaged stretch, patch 0.2-0.6 (the default), gives the same reading
+    assert mod.full_engagement_patch(26, 53.975 / 2, 3.8) == pytest.approx(0.266, abs=1e-3)
+    assert mod.full_engagement_patch(26, 53.975 / 2, 0.95) == pytest.approx(0.136, abs=1e-3)
+    e = mod.two_window_spread(packings=eight)
+    assert e.loc["band", ["geometric mean", "95% low", "95% high", "log sd between packings"]].tolist() == pytest.approx(
+        [1.069, 0.778, 1.470, 0.381], abs=1e-3)
+    assert e.loc["band", "window corr"] == pytest.approx(-0.087, abs=1e-3)
+    assert e.loc["coarse", ["geometric mean", "95% low", "95% high", "window corr"]].tolist() == pytest.approx(
+        [0.433, 0.264, 0.711, -0.148], abs=1e-3)
+    assert e.loc["band", "95% low"] < 1 < e.loc["band", "95% high"] < 1.76 and e.loc["coarse", "95% high"] < 1
     with pytest.raises(ValueError, match="at least 0.2 apart"):
         mod.two_window_ratios(windows=(0.1, 0.2))
     with pytest.raises(ValueError, match=r"no band pair recorded on packings \[999\]"):

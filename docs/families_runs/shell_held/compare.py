@@ -794,12 +794,26 @@ def band_over_coarse_unpaired(width: int = 33, sides: str = "free", window: floa
             "mann-whitney p": float(stats.mannwhitneyu(b, c, alternative="two-sided").pvalue)}
 
 
-def two_window_ratios(width: int = 33, sides: str = "free", windows: tuple[float, ...] = (0.1, 0.4)) -> pd.DataFrame:
+def full_engagement_patch(length_mm: float, radius_mm: float, penetration_mm: float) -> float:
+    """Contact-patch position (fraction of the block length, as in :data:`PATCH_WINDOWS`) from which the disc's whole
+    contact arc lies inside the block: the arc runs from below the disc centre to a half chord ahead of it, and the patch
+    centre is half a half chord ahead of the centre (``families.middle_window``), so the back of the arc passes the
+    entry face x = 0 when the patch centre reaches half a half chord. Before it the disc cuts the entry corner, not the
+    steady groove: on the 26 mm block (disc 53.975 mm) from patch 0.136 at p 1.9 mm (0.95 reduced) and 0.266 at p 7.6
+    mm (3.8 reduced), so window 0.1 of a deep run is mostly entry (session 47)."""
+    from deckgen.families import half_chord_mm
+
+    return half_chord_mm(radius_mm, penetration_mm) / 2 / length_mm
+
+
+def two_window_ratios(width: int = 33, sides: str = "free", windows: tuple[float, ...] = (0.2, 0.4)) -> pd.DataFrame:
     """Session 47: per packing of :func:`packing_replicates` (index), F_n p 7.6 / 1.9 mm of the ``band`` and ``coarse``
     pairs over several non-overlapping windows of :data:`PATCH_WINDOWS` read as one stretch of the cut: each run's F_n
-    is the mean over the windows weighted by their rows (for (0.1, 0.4), the contact patch over 0.1-0.3 and 0.4-0.6 of
-    the block, 10.4 mm of the 26 mm block; the 0.3-0.4 stretch between them has no window of its own). What a run
-    over a longer block would average, if the rock of one stretch does not tell the next (:func:`two_window_spread`
+    is the mean over the windows weighted by their rows. The default (0.2, 0.4) is the contact patch over 0.2-0.6 of
+    the block, 10.4 mm of the 26 mm block, where the deep cut's arc is 88 % inside the block at the start and whole from
+    0.266 (:func:`full_engagement_patch`); (0.1, 0.4) reads patch 0.1-0.3 and 0.4-0.6, but a deep run's window 0.1 is
+    mostly its entry (its arc 69 % inside at 0.1), so that stretch mixes an entry transient into the deep cut. What a
+    run over a longer block would average, if the rock of one stretch does not tell the next (:func:`two_window_spread`
     checks that). NaN where a pair was not run."""
     import numpy as np
 
@@ -825,11 +839,11 @@ def two_window_ratios(width: int = 33, sides: str = "free", windows: tuple[float
     return pd.DataFrame(rows).set_index("packing")
 
 
-def two_window_spread(width: int = 33, sides: str = "free", windows: tuple[float, float] = (0.1, 0.4),
+def two_window_spread(width: int = 33, sides: str = "free", windows: tuple[float, float] = (0.2, 0.4),
                       packings: tuple[int, ...] | None = None) -> pd.DataFrame:
     """Session 47: for ``band`` and ``coarse`` (rows), over the packings that have the pair (at least three): the
     geometric mean of :func:`two_window_ratios` with its Student t 95 % interval and the log sd between packings, beside
-    the same for each single window (``log sd window 0.1`` ...), and the Pearson correlation between packings of the
+    the same for each single window (``log sd window 0.2`` ...), and the Pearson correlation between packings of the
     two windows' log ratios (``window corr``, its two-sided ``window corr p``). A correlation near 0 or below says the
     rock of one stretch of a run does not tell the next, so averaging more of the cut narrows the spread between
     packings (for two independent windows of equal spread, by sqrt 2); a correlation near 1 says a packing's ratio is

@@ -756,8 +756,9 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
 
 
 def _only_packings(t: pd.DataFrame, packings: tuple[int, ...] | None, who: str, width: int, sides: str) -> pd.DataFrame:
-    """The rows of a per-packing table ``t`` for ``packings`` (all where None); a packing without a recorded band pair
-    is refused with the recorded ones named."""
+    """The rows of a per-packing table ``t`` (indexed by packing like :func:`packing_replicates`, whose rows are the
+    packings with a recorded band pair) for ``packings`` (all where None); a packing not in ``t`` is refused with the
+    recorded ones named."""
     if packings is None:
         return t
     missing = sorted(set(packings) - set(t.index))
@@ -800,7 +801,7 @@ def full_engagement_patch(length_mm: float, radius_mm: float, penetration_mm: fl
     centre is half a half chord ahead of the centre (``families.middle_window``), so the back of the arc passes the
     entry face x = 0 when the patch centre reaches half a half chord. Before it the disc cuts the entry corner, not the
     steady groove: on the 26 mm block (disc 53.975 mm) from patch 0.136 at p 1.9 mm (0.95 reduced) and 0.266 at p 7.6
-    mm (3.8 reduced), so window 0.1 of a deep run is mostly entry (session 47)."""
+    mm (3.8 reduced), so 83 % of a deep run's window 0.1 comes before full engagement (session 47)."""
     from deckgen.families import half_chord_mm
 
     return half_chord_mm(radius_mm, penetration_mm) / 2 / length_mm
@@ -811,16 +812,18 @@ def two_window_ratios(width: int = 33, sides: str = "free", windows: tuple[float
     pairs over several non-overlapping windows of :data:`PATCH_WINDOWS` read as one stretch of the cut: each run's F_n
     is the mean over the windows weighted by their rows. The default (0.2, 0.4) is the contact patch over 0.2-0.6 of
     the block, 10.4 mm of the 26 mm block, where the deep cut's arc is 88 % inside the block at the start and whole from
-    0.266 (:func:`full_engagement_patch`); (0.1, 0.4) reads patch 0.1-0.3 and 0.4-0.6, but a deep run's window 0.1 is
-    mostly its entry (its arc 69 % inside at 0.1), so that stretch mixes an entry transient into the deep cut. What a
+    0.266 (:func:`full_engagement_patch`); (0.1, 0.4) reads patch 0.1-0.3 and 0.4-0.6 (two 5.2 mm pieces), but 83 % of
+    a deep run's window 0.1 comes before its arc is whole in the block (69 % of its x extent inside at 0.1), so that
+    reading mixes the entry into the deep cut. What a
     run over a longer block would average, if the rock of one stretch does not tell the next (:func:`two_window_spread`
     checks that). NaN where a pair was not run."""
     import numpy as np
 
     lo = sorted(windows)
-    if any(w not in PATCH_WINDOWS for w in lo) or any(b - a < 0.2 - 1e-9 for a, b in zip(lo, lo[1:])):
-        raise ValueError(f"two_window_ratios: windows {windows} must be starts of PATCH_WINDOWS {PATCH_WINDOWS} at least "
-                         "0.2 apart (each window spans 0.2 of the block; overlapping windows count rock twice)")
+    if not lo or any(w not in PATCH_WINDOWS for w in lo) or any(b - a < 0.2 - 1e-9 for a, b in zip(lo, lo[1:])):
+        raise ValueError(f"two_window_ratios: windows {windows} must be one or more starts of PATCH_WINDOWS "
+                         f"{PATCH_WINDOWS} at least 0.2 apart (each window spans 0.2 of the block; overlapping windows "
+                         "count rock twice)")
     w = pd.read_csv(PAIR_WINDOWS_CSV)
     w = w[w["patch_lo_1"].isin(lo)].assign(weighted=lambda d: d["force_normal_N_mean_steady"] * d["rows"])
     g = w.groupby("case")
@@ -872,6 +875,10 @@ def two_window_spread(width: int = 33, sides: str = "free", windows: tuple[float
             row[f"log sd window {w}"] = float(l.std(ddof=1))
         row["window corr"], row["window corr p"] = float(r.statistic), float(r.pvalue)
         rows.append(row)
+    if not rows:
+        raise ValueError(f"two_window_spread: needs at least three packings with the band or the coarse pair (packings "
+                         f"{sorted(both.index)}: band on {both['band'].notna().sum()}, coarse on "
+                         f"{both['coarse'].notna().sum()}; fix: pass more packings or none)")
     return pd.DataFrame(rows).set_index("size")
 
 

@@ -2276,7 +2276,7 @@ def test_808_coarse_reference_and_two_stretches_of_one_cut():
 def test_909_band_pair_tests_session_47s_stretch_readings_out_of_sample():
     """Session 48: packing 909's band pair (docs/families.md, "The cutter shell held in y", its session-48 part), run
     after session 47 had picked the stretch readings on eight packings. Its case-window ratio is x0.66 (+- 0.13 within
-    the runs), the third below 1; its stretch ratios (x0.67 over patch 0.2-0.6, x0.73 over 0.1-0.3 with 0.4-0.6) lie
+    the runs), the third below 1; its stretch ratios (x0.67 over patch 0.2-0.6, x0.72 over 0.1-0.3 with 0.4-0.6) lie
     inside the eight packings' 95 % prediction intervals, and over nine packings the stretch still excludes seed 001's
     x1.76 (x1.02, t 95 % 0.75-1.37) while the case window holds it (x1.16, 0.70-1.95)."""
     from scipy import stats
@@ -2315,8 +2315,8 @@ def test_909_band_pair_tests_session_47s_stretch_readings_out_of_sample():
         half = stats.t.ppf(0.975, len(lg) - 1) * lg.std(ddof=1) * np.sqrt(1 + 1 / len(lg))
         return float(np.exp(lg.mean() - half)), float(np.exp(lg.mean() + half))
 
-    # session 47's predictions D2 and D7 were these intervals of the eight; 909 lies inside both, and inside the case
-    # window's (0.23-6.86), where D1 (its case-window ratio above 1) did not hold
+    # session 47's predictions D2 and D7 were these intervals of the eight (D7 written as 0.41-2.79); 909 lies inside
+    # both, and inside the case window's (0.23-6.86), where D1 (its case-window ratio above 1) did not hold
     two = mod.two_window_ratios()
     two1 = mod.two_window_ratios(windows=(0.1, 0.4))
     assert [two.loc[909, "band"], two1.loc[909, "band"]] == pytest.approx([0.671, 0.725], abs=1e-3)
@@ -2352,9 +2352,10 @@ def test_909_band_pair_tests_session_47s_stretch_readings_out_of_sample():
     u9 = mod.band_over_coarse_unpaired(packings=nine)
     assert [u9["band packings"], u9["coarse packings"]] == [9, 8]
     assert [u9["band/coarse"], u9["95% low"], u9["95% high"]] == pytest.approx([3.806, 1.718, 8.432], abs=1e-3)
-    # the shallow cut holds together (no piece above 9 grains) and ends on a load from patch 0.55 (F_n per 0.05 of
-    # patch 183 and 241 N against 44-122 N over 0.25-0.45); the deep cut's first piece of 25 grains or more (26) comes
-    # off its entry corner before the patch reaches the block, its largest (28) at patch 0.21 (27 left at the end)
+    # the shallow cut holds together (no piece above 9 grains) and ends on a load from patch 0.55 (F_n 183 N over
+    # 0.55-0.60 and 241 N at its last sample, against 44-122 N per 0.05 of patch over 0.25-0.55); the deep cut's first
+    # piece of 25 grains or more (26) comes off its entry corner before the patch reaches the block, its largest (28) at
+    # patch 0.21 (27 left at the end)
     held = ROOT / "docs" / "families_runs" / "shell_held"
     for p, biggest, first, broken in (("p1p9", 9, 0.156, 5221), ("p7p6", 28, 0.210, 8714)):
         pt = mod.pd.read_csv(held / f"piece_timeline_k909_unrel_band_{p}.csv")
@@ -2362,6 +2363,6 @@ def test_909_band_pair_tests_session_47s_stretch_readings_out_of_sample():
         assert pt.loc[pt["largest_piece_grains"] == biggest, "patch_centre_1"].iloc[0] == pytest.approx(first, abs=2e-3)
     pt = mod.pd.read_csv(held / "piece_timeline_k909_unrel_band_p1p9.csv")
     binned = pt[pt["patch_centre_1"] > 0].groupby(pt["patch_centre_1"] // 0.05 * 0.05)["force_normal_N_mean"].mean()
-    assert binned.loc[0.54:].min() > 180 and binned.loc[0.24:0.46].max() < 125
+    assert binned.loc[0.54:].min() > 180 and binned.loc[0.24:0.51].max() < 125
     pt7 = mod.pd.read_csv(held / "piece_timeline_k909_unrel_band_p7p6.csv")
     assert pt7.loc[pt7["largest_piece_grains"] >= 25, "patch_centre_1"].iloc[0] < 0

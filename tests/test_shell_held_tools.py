@@ -176,13 +176,14 @@ def _flat(path: Path) -> dict:
     return dict(walk(yaml.safe_load(path.read_text())))
 
 
-def test_session42_to_47_cases_change_only_the_packing_seed_or_the_dumps():
+def test_session42_to_48_cases_change_only_the_packing_seed_or_the_dumps():
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
     # 505, 606, 707, 808: no r 0.3 mm pair; 606's coarse pair added in session 46, 808's band pair in session 46 and
-    # its coarse pair in session 47; 909 (session 47): the band pair only
+    # its coarse pair in session 47; 909: the band pair written in session 47 (run in session 48), its coarse pair in
+    # session 48
     tails = {404: ("_unrel", "_unrel_band", "_unrel_s016"), 505: ("_unrel_band", "_unrel_s016"),
              606: ("_unrel_band", "_unrel_s016"), 707: ("_unrel_band", "_unrel_s016"), 808: ("_unrel_band", "_unrel_s016"),
-             909: ("_unrel_band",)}
+             909: ("_unrel_band", "_unrel_s016")}
     for seed in (606, 707, 808, 909):
         assert sorted(f.name for f in rec.glob(f"lin_red_s100_*_k{seed}*.yaml")) == sorted(
             f"lin_red_s100_{p}_k{seed}{tail}.yaml" for p in ("p1p9", "p7p6") for tail in tails[seed])

@@ -83,7 +83,8 @@ YFIX_WINDOWS_CSV = HERE / "linear_yfix_windows.csv"
 #: packings 12345 and 202 (one report per grain size holds both), 303 (session 41), 404 (session 42; not a family
 #: packing: add_packing.py), 505 (session 43, no r 0.3 mm pair), 606 (session 44, the band pair; its coarse reference
 #: session 46; no r 0.3 mm pair), 707 (session 45, no r 0.3 mm pair), 808 (session 46, the band pair; its coarse reference session 47; no r 0.3 mm pair)
-#: and 909 (session 48, the band pair only: the ninth packing that tests session 47's stretch readings)
+#: and 909 (session 48, the band pair, the ninth packing that tests session 47's stretch readings, then its coarse
+#: reference; no r 0.3 mm pair)
 GRAIN_PAIRS = {
     (10, "free", 12345): {"coarse": ("_narrow", HERE / "linear_narrow"),
                           "fine": ("_narrow_fine", HERE / "linear_narrow_fine")},
@@ -107,7 +108,8 @@ GRAIN_PAIRS = {
                         "band": ("_k707_unrel_band", HERE / "linear_unrel_band")},
     (33, "free", 808): {"coarse": ("_k808_unrel_s016", HERE / "linear_unrel_s016"),
                         "band": ("_k808_unrel_band", HERE / "linear_unrel_band")},
-    (33, "free", 909): {"band": ("_k909_unrel_band", HERE / "linear_unrel_band")}}
+    (33, "free", 909): {"coarse": ("_k909_unrel_s016", HERE / "linear_unrel_s016"),
+                        "band": ("_k909_unrel_band", HERE / "linear_unrel_band")}}
 #: the 33 mm block's coarse pair with session 31's r 0.3 mm shell (``*_unrel.yaml``, run on the fixed deck in sessions
 #: 35, 41 and 42), per :data:`GRAIN_PAIRS` key: the shell-radius reference of :func:`packing_replicates`
 SHELL03_TAILS = {(33, "free", 12345): "_unrel", (33, "free", 202): "_k202_unrel", (33, "free", 303): "_k303_unrel",
@@ -706,7 +708,7 @@ def packing_replicates(width: int = 33, sides: str = "free", window: float = 0.4
         row = {"packing": packing}
 
         def put(col: str, t: str | None) -> None:  # the pair's ratio and error, NaN where it was not run
-            has = t in ratios.index  # 505, 606, 707, 808, 909: no r 0.3 mm pair; 909: no coarse
+            has = t in ratios.index  # 505, 606, 707, 808, 909: no r 0.3 mm pair
             row[col] = ratios.loc[t, window] if has else float("nan")
             row[f"{col} s.e."] = errors.loc[t, window] if has else float("nan")
 
@@ -741,7 +743,7 @@ def packing_spread(width: int = 33, sides: str = "free", window: float = 0.4,
     rel["coarse/coarse r0.3"] = np.hypot(rel["coarse"], rel["coarse r0.3"])
     rows = []
     for col in ("band", "coarse", "band/coarse", "coarse r0.3", "coarse/coarse r0.3"):
-        ok = t[col].notna()  # no r 0.3 mm shell pair on 505 / 606 / 707 / 808 / 909 (sessions 43-48), no coarse on 909
+        ok = t[col].notna()  # no r 0.3 mm shell pair on 505 / 606 / 707 / 808 / 909 (sessions 43-48)
         if ok.sum() < 2:
             continue
         lg = np.log(t.loc[ok, col].to_numpy(dtype=float))

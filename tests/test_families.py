@@ -1217,6 +1217,29 @@ def test_recorded_rotary_runs_on_seven_packings_hold_the_force_rise_with_r_defin
     assert [halves["0.3_0.65"], halves["0.65_1.0"]] == pytest.approx([0.337, 0.305], abs=1e-3)
 
 
+def _prediction_interval(ratios) -> tuple[float, float]:
+    """95 % prediction interval of one more packing's ratio from these packings' ratios (Student t on the logs, n - 1
+    d.f.)."""
+    from scipy import stats
+
+    lg = np.log(np.asarray(ratios, float))
+    half = stats.t.ppf(0.975, len(lg) - 1) * lg.std(ddof=1) * np.sqrt(1 + 1 / len(lg))
+    return float(np.exp(lg.mean() - half)), float(np.exp(lg.mean() + half))
+
+
+def _assert_band_coarse_spread(mod, packings: tuple[int, ...], coarse: list[float], band_coarse: list[float],
+                               unpaired: list[float], welch_p: float, welch_abs: float) -> None:
+    """compare.py's coarse case-window spread and band over coarse (per packing and unpaired) over ``packings``, each
+    of which has both pairs: geometric mean, 95 % low and high to 1e-3, and the Welch p."""
+    s = mod.packing_spread(packings=packings)
+    assert s.loc["coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(coarse, abs=1e-3)
+    assert s.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(band_coarse, abs=1e-3)
+    u = mod.band_over_coarse_unpaired(packings=packings)
+    assert [u["band packings"], u["coarse packings"]] == [len(packings)] * 2
+    assert [u["band/coarse"], u["95% low"], u["95% high"]] == pytest.approx(unpaired, abs=1e-3)
+    assert u["welch p"] == pytest.approx(welch_p, abs=welch_abs)
+
+
 def _docs_script(path: Path):
     """Import a script under docs/families_runs (not a package) as a module."""
     return load_script(path)
@@ -2208,15 +2231,9 @@ def test_808_coarse_reference_and_two_stretches_of_one_cut():
     assert sorted(rep.loc[[12345, 202, 303, 404, 505, 606, 707, 808]].query("`band/coarse` < 1").index) == [606, 808]  # the
     # two packings with the lowest band ratios (909, session 48, is the third)
     eight = (12345, 202, 303, 404, 505, 606, 707, 808)
+    _assert_band_coarse_spread(mod, eight, coarse=[0.306, 0.152, 0.613], band_coarse=[4.084, 1.336, 12.489],
+                               unpaired=[4.084, 1.802, 9.255], welch_p=0.00251, welch_abs=1e-5)
     s8 = mod.packing_spread(packings=eight)
-    assert s8.loc["coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([0.306, 0.152, 0.613],
-                                                                                                abs=1e-3)
-    assert s8.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(
-        [4.084, 1.336, 12.489], abs=1e-3)
-    u8 = mod.band_over_coarse_unpaired(packings=eight)
-    assert [u8["band packings"], u8["coarse packings"]] == [8, 8]
-    assert [u8["band/coarse"], u8["95% low"], u8["95% high"]] == pytest.approx([4.084, 1.802, 9.255], abs=1e-3)
-    assert u8["welch p"] == pytest.approx(0.00251, abs=1e-5)
     # two stretches of one cut: each run's F_n is the rows-weighted mean of windows 0.1 and 0.4 (recomputed here from
     # the recorded windows), the ratio of the two runs' stretch means
     raw = mod.pd.read_csv(mod.PAIR_WINDOWS_CSV).set_index(["case", "patch_lo_1"])
@@ -2310,21 +2327,16 @@ def test_909_band_pair_tests_session_47s_stretch_readings_out_of_sample():
     nine = eight + (909,)
     assert sorted(rep.index[rep["band"] < 1]) == [606, 808, 909]
 
-    def prediction_interval(ratios) -> tuple[float, float]:  # of one more packing from eight (t, 7 d.f.)
-        lg = np.log(np.asarray(ratios, float))
-        half = stats.t.ppf(0.975, len(lg) - 1) * lg.std(ddof=1) * np.sqrt(1 + 1 / len(lg))
-        return float(np.exp(lg.mean() - half)), float(np.exp(lg.mean() + half))
-
     # session 47's predictions D2 and D7 were these intervals of the eight (D7 written as 0.41-2.79); 909 lies inside
     # both, and inside the case window's (0.23-6.86), where D1 (its case-window ratio above 1) did not hold
     two = mod.two_window_ratios()
     two1 = mod.two_window_ratios(windows=(0.1, 0.4))
     assert [two.loc[909, "band"], two1.loc[909, "band"]] == pytest.approx([0.671, 0.725], abs=1e-3)
-    lo, hi = prediction_interval(two.loc[list(eight), "band"])
+    lo, hi = _prediction_interval(two.loc[list(eight), "band"])
     assert [lo, hi] == pytest.approx([0.411, 2.778], abs=1e-3) and lo < two.loc[909, "band"] < hi
-    lo, hi = prediction_interval(two1.loc[list(eight), "band"])
+    lo, hi = _prediction_interval(two1.loc[list(eight), "band"])
     assert [lo, hi] == pytest.approx([0.470, 2.773], abs=1e-3) and lo < two1.loc[909, "band"] < hi
-    lo, hi = prediction_interval(rep.loc[list(eight), "band"])
+    lo, hi = _prediction_interval(rep.loc[list(eight), "band"])
     assert [lo, hi] == pytest.approx([0.227, 6.860], abs=1e-3) and lo < rep.loc[909, "band"] < 1
     # over nine packings: the case window x1.16 holds x1.76, the engaged stretch (0.2-0.6) x1.02 excludes it, as every
     # single window but the case window does
@@ -2375,8 +2387,6 @@ def test_909_coarse_reference_splits_a_side_in_its_case_window():
     while the earlier windows rise (x1.85, x2.21, x1.93). Over nine packings the coarse case window is x0.34 (t 95 %
     0.18-0.65), band over coarse x3.4 per packing (1.2-9.7) and unpaired (Welch 1.6-7.3); over the engaged stretch the
     coarse reference is x0.49 (0.29-0.84) with 909's x1.43, the first coarse stretch ratio above 1."""
-    from scipy import stats
-
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
     rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
     for p in ("1p9", "7p6"):
@@ -2412,19 +2422,12 @@ def test_909_coarse_reference_splits_a_side_in_its_case_window():
     assert sorted(rep.index[rep["band/coarse"] < 1]) == [606, 808, 909]  # the three lowest band ratios
     eight = (12345, 202, 303, 404, 505, 606, 707, 808)
     nine = eight + (909,)
-    lg = np.log(rep.loc[list(eight), "coarse"].to_numpy(float))
-    half = stats.t.ppf(0.975, 7) * lg.std(ddof=1) * np.sqrt(1 + 1 / 8)
-    assert np.exp(lg.mean() - half) < rep.loc[909, "coarse"] < 1 < np.exp(lg.mean() + half)  # inside 0.038-2.47
+    lo, hi = _prediction_interval(rep.loc[list(eight), "coarse"])
+    assert lo < rep.loc[909, "coarse"] < 1 < hi  # inside 0.038-2.47
     s9 = mod.packing_spread(packings=nine)
     assert s9["packings"].to_dict() == {"band": 9, "coarse": 9, "band/coarse": 9, "coarse r0.3": 4, "coarse/coarse r0.3": 4}
-    assert s9.loc["coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx([0.340, 0.178, 0.649],
-                                                                                                abs=1e-3)
-    assert s9.loc["band/coarse", ["geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(
-        [3.423, 1.205, 9.723], abs=1e-3)
-    u9 = mod.band_over_coarse_unpaired(packings=nine)
-    assert [u9["band packings"], u9["coarse packings"]] == [9, 9]
-    assert [u9["band/coarse"], u9["95% low"], u9["95% high"]] == pytest.approx([3.423, 1.596, 7.342], abs=1e-3)
-    assert u9["welch p"] == pytest.approx(0.0036, abs=1e-4)
+    _assert_band_coarse_spread(mod, nine, coarse=[0.340, 0.178, 0.649], band_coarse=[3.423, 1.205, 9.723],
+                               unpaired=[3.423, 1.596, 7.342], welch_p=0.0036, welch_abs=1e-4)
     # along the cut: 909's coarse stretch ratio is the first above 1; over nine the coarse stretch stays below 1
     two = mod.two_window_ratios()
     assert two.loc[909, "coarse"] == pytest.approx(1.431, abs=1e-3) and (two.loc[list(eight), "coarse"] < 1).all()

@@ -456,7 +456,8 @@ def test_recorded_dumps_of_606_load_up_to_a_break_and_the_local_rock_does_not_ra
     when a 39-grain piece breaks off: its case window is mostly one long load. The rock the disc meets next, as
     rendered, ranks with F_n at the dumps on 505 (1 mm ahead: 0.55) but not on 606 (-0.09); on 606 only the 10 mm
     ahead does (0.66, over the 32 dumps whose 10 mm lie on the block). The crushed rock under the disc ranks on both
-    (0.45 / 0.50)."""
+    (0.45 / 0.50). 707, 808 and 909 were added later (sessions 45, 46 and 49); on 909 the rendered rock ahead ranks
+    against F_n at every distance."""
     mod = load_script(HELD / "groove_fill.py")
     d = pd.read_csv(HELD / "groove_fill_dumps.csv")
     k6 = d[d["case"] == "lin_red_s100_p1p9_k606_unrel_band"].set_index("step")
@@ -485,21 +486,29 @@ def test_recorded_dumps_of_606_load_up_to_a_break_and_the_local_rock_does_not_ra
             assert pt["largest_piece_grains"].iloc[-1] == 21 and binned.max().loc[0.14:0.16].max() == pytest.approx(277.5, abs=0.1)
             assert binned.mean().loc[0.29:].max() < 75
     # 808 (session 46, its 55 dumps): under the disc 0.58 again, ahead 0.26
-    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186), (707, 0.652, -0.371), (808, 0.583, 0.260)):
+    # 909 (session 48's run, added in session 49 from its run folder; its 56 dumps): under the disc 0.36, ahead -0.44
+    for seed, under, ahead in ((505, 0.447, 0.343), (606, 0.495, -0.186), (707, 0.652, -0.371), (808, 0.583, 0.260),
+                               (909, 0.356, -0.445)):
         name = f"lin_red_s100_p1p9_k{seed}_unrel_band"
         assert links[(name, "solid_fraction_all_under_1")] == pytest.approx(under, abs=1e-3)
         assert links[(name, "solid_fraction_all_ahead_1")] == pytest.approx(ahead, abs=1e-3)
     r = pd.read_csv(HELD / "groove_fill_rendered_at_dumps.csv")
-    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606, 707, 808)]
+    assert sorted(set(r["case"])) == [f"lin_red_s100_p1p9_k{k}_unrel_band" for k in (404, 505, 606, 707, 808, 909)]
     rl = mod.dump_links(r).set_index(["case", "fill"])["spearman_rho_1"]
     got = {k: [rl[(f"lin_red_s100_p1p9_k{k}_unrel_band", f"solid_fraction_rendered_ahead{a}mm_1")] for a in (1, 2, 5, 10)]
-           for k in (505, 606, 707, 808)}
+           for k in (505, 606, 707, 808, 909)}
     assert got[505] == pytest.approx([0.548, 0.364, 0.354, 0.234], abs=1e-3)
     assert got[606] == pytest.approx([-0.094, -0.158, 0.262, 0.655], abs=1e-3)
     assert got[707] == pytest.approx([-0.239, -0.484, -0.482, -0.355], abs=1e-3)
     assert got[808] == pytest.approx([0.460, 0.323, 0.321, -0.198], abs=1e-3)  # session 46
+    # 909 (session 49): the rendered rock ahead ranks against F_n at every distance, so over five packings with dense
+    # dumps the 1 mm link has both signs (0.55, -0.09, -0.24, 0.46, -0.34): the rendered packing does not tell the load
+    assert got[909] == pytest.approx([-0.335, -0.431, -0.560, -0.214], abs=1e-3)
+    assert sum(got[k][0] > 0 for k in got) == 2 and sum(got[k][0] < 0 for k in got) == 3
     k8 = d[d["case"] == "lin_red_s100_p1p9_k808_unrel_band"]
     assert k8["step"].tolist() == list(range(0, 540001, 10000))
+    k9 = d[d["case"] == "lin_red_s100_p1p9_k909_unrel_band"].set_index("step")
+    assert k9.index.tolist() == list(range(0, 550001, 10000)) and k9["force_normal_N_after"].max() == pytest.approx(245.294, abs=1e-3)
     k6r = r[r["case"] == "lin_red_s100_p1p9_k606_unrel_band"]
     assert len(k6r) == 41 and k6r["solid_fraction_rendered_ahead10mm_1"].notna().sum() == 32
     # the rendered rows are the dumps' own (same steps, patch centres and F_n)

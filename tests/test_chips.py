@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from deckgen.chips import cutter_work, find_chips, groove_area, kinematic_volume
+from deckgen.chips import cutter_work, detachment, find_chips, groove_area, kinematic_volume
 from deckgen.datafile import read_bonds
 from deckgen.geometry import ccs_disc, v_disc
 from helpers import load_script
@@ -21,6 +21,33 @@ RUNS = Path(__file__).resolve().parent / "data" / "runs"
 def _atoms(n: int, r: float = 1e-3) -> pd.DataFrame:
     return pd.DataFrame({"id": np.arange(1, n + 1), "type": 1, "radius": r,
                          "x": np.arange(n) * 2 * r, "y": 0.0, "z": 0.0})
+
+
+def test_detachment_is_the_first_break_that_frees_a_piece_of_min_grains():
+    """A chain 1-2-...-10 (the body) with a 4-grain branch 11-14 hanging off grain 5 by the bond 5-11. Bonds break
+    at steps 100 (10-9: one grain of debris), 200 (13-14: the branch's tail, 1 grain) and 300 (5-11: the 3-grain rest
+    of the branch comes off). With min_grains 3 the detachment is step 300: F_n's largest value up to it is the
+    destructive force (step 200's 9 N, not the later 12 N), the penetration at step 300 the penetration at failure.
+    With min_grains 2 it is still 300 (the freed tail and debris are single grains); with 4 no piece is big enough."""
+    chain = [[i, i + 1] for i in range(1, 10)]
+    branch = [[5, 11], [11, 12], [12, 13], [13, 14]]
+    bonds = np.array(chain + branch)
+    broken = pd.DataFrame({"id1": [10, 13, 5], "id2": [9, 14, 11], "step": [100, 200, 300]})
+    ts = pd.DataFrame({"step": [0, 100, 200, 300, 400], "force_normal_N": [0.0, 4.0, 9.0, 3.0, 12.0],
+                       "penetration_m": [0.0, 1e-4, 2e-4, 3e-4, 4e-4]})
+    d = detachment(bonds, broken, ts, min_grains=3)
+    assert d["detachment_step"] == 300
+    assert d["force_normal_N_destructive"] == 9.0 and d["penetration_at_destructive_m"] == pytest.approx(2e-4)
+    assert d["penetration_at_failure_m"] == pytest.approx(3e-4)
+    assert math.isnan(d["force_side_N_destructive"])  # the series has no side force
+    with_side = detachment(bonds, broken, ts.assign(force_side_N=[0.0, -1.0, -2.5, -1.0, -6.0]), min_grains=3)
+    assert with_side["force_side_N_destructive"] == -2.5
+    assert detachment(bonds, broken, ts, min_grains=2)["detachment_step"] == 300
+    none = detachment(bonds, broken, ts, min_grains=4)
+    assert none["detachment_step"] == -1 and math.isnan(none["force_normal_N_destructive"])
+    # a piece that later splits below the size still counts from when it came off (the scan is in step order)
+    split = pd.concat([broken, pd.DataFrame({"id1": [11], "id2": [12], "step": [350]})], ignore_index=True)
+    assert detachment(bonds, split, ts, min_grains=3)["detachment_step"] == 300
 
 
 def test_two_triangles_split_into_body_and_chip():

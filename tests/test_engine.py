@@ -10,6 +10,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from deckgen.deck import render_case
@@ -260,6 +261,21 @@ def test_indentation_kinematics_and_contact(tmp_path, cache):
     after = s[cut["V"] * s["time_s"] > gap + 0.5e-3]
     assert len(after) > 5 and after["force_z_N"].max() > 1.0  # the rock pushes the disc up
     assert s["bonds"].iloc[-1] < spec["derived"]["n_bonds"]  # the indentation broke bonds
+    # parsed: the penetration at the peak normal force is that row's, and the chip's break-off (deckgen.chips.detachment)
+    # comes with a destructive force no larger than the peak, reached no later than the break-off
+    from deckgen.results import parse_run
+
+    summ = parse_run(out, tmp_path / "indent_parsed")
+    ts = pd.read_parquet(tmp_path / "indent_parsed" / "timeseries.parquet")
+    i = int(np.argmax(ts["force_normal_N"].abs().to_numpy()))
+    assert summ["force_normal_N_peak"] == pytest.approx(ts["force_normal_N"].iloc[i])
+    assert summ["penetration_at_peak_normal_m"] == pytest.approx(ts["penetration_m"].iloc[i])
+    assert 0 < summ["penetration_at_peak_normal_m"] <= 1.5e-3 + 1e-6
+    if summ["detachment_step"] >= 0:
+        assert summ["force_normal_N_destructive"] <= summ["force_normal_N_peak"]
+        assert 0 < summ["penetration_at_destructive_m"] <= summ["penetration_at_failure_m"] <= 1.5e-3 + 1e-6
+    else:
+        assert math.isnan(summ["force_normal_N_destructive"]) and math.isnan(summ["penetration_at_failure_m"])
 
 
 def test_rotary_path_moves_the_shell_rigidly(tmp_path, cache):

@@ -77,6 +77,46 @@ def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> t
     return label, sizes, int(np.argmax(sizes)) if n else -1
 
 
+#: the smallest piece whose break-off counts as the detachment of an indentation run (:func:`detachment`)
+DETACH_MIN_GRAINS = 25
+
+
+def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
+               min_grains: int = DETACH_MIN_GRAINS) -> dict[str, Any]:
+    """The chip's break-off in an indentation run. Seed 000 pushes the disc "until the material was detached
+    entirely" and reports the maximum (destructive) normal force; a reduced run pushes a fixed depth, so its peak over
+    the whole push can come after the chip is off, from the disc pressing on into the block.
+
+    Detachment: the first step of the broken-bond record (``broken``: id1, id2, step) at which a component of the bond
+    graph other than the body (the largest) holds at least ``min_grains`` grains. A piece can later split below the
+    size, so the steps are scanned in order rather than bisected. Returns ``detachment_step``, the penetration then
+    (``penetration_at_failure_m``), the largest F_n of the series up to that step (``force_normal_N_destructive``),
+    the side force of the same row (``force_side_N_destructive``, when the series has it) and the penetration at it
+    (``penetration_at_destructive_m``); NaN (step -1) when no such piece breaks off."""
+    out: dict[str, Any] = {"detachment_step": -1, "penetration_at_failure_m": float("nan"),
+                           "force_normal_N_destructive": float("nan"), "force_side_N_destructive": float("nan"),
+                           "penetration_at_destructive_m": float("nan")}
+    if not len(broken) or not len(ts):
+        return out
+    ids = np.unique(bonds)
+    steps = broken["step"].to_numpy(np.int64)
+    pairs = broken[["id1", "id2"]].to_numpy(np.int64)
+    for s in np.unique(steps):
+        _, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
+        if (np.delete(sizes, body) >= min_grains).any():
+            upto = ts[ts["step"] <= s]
+            if not len(upto):
+                return out
+            i = int(np.argmax(upto["force_normal_N"].to_numpy()))
+            out.update(detachment_step=int(s), penetration_at_failure_m=float(upto["penetration_m"].iloc[-1]),
+                       force_normal_N_destructive=float(upto["force_normal_N"].iloc[i]),
+                       penetration_at_destructive_m=float(upto["penetration_m"].iloc[i]))
+            if "force_side_N" in upto.columns:
+                out["force_side_N_destructive"] = float(upto["force_side_N"].iloc[i])
+            return out
+    return out
+
+
 def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid_fraction: float,
                min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Chips of the remaining bond graph among rock grains (type 1) of ``atoms``.
@@ -196,6 +236,8 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     table, out = find_chips(bonds, broken[["id1", "id2"]].to_numpy(dtype=np.int64), atoms, phi, min_grains)
     work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
+    if derived.get("kinematics_mode") == "indentation":
+        out.update(detachment(bonds, broken, ts))
     out.update({
         "cutter_work_J": work,
         "kinematic_volume_m3": v_kin,

@@ -132,6 +132,9 @@ def _forces_x(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
     if indent:
         x = ts["penetration_m"].to_numpy() * 1e3
         ax.set_xlabel("penetration (mm)")
+        fail = summary.get("penetration_at_failure_m")
+        if _finite(fail):  # the first piece of the block off (deckgen.chips.detachment)
+            ax.axvline(fail * 1e3, color="0.4", ls="--", lw=0.8, label="first piece off")
     else:
         x = ts["cutter_x_m"].to_numpy() * 1e3
         ax.set_xlabel("cutter centre x (mm)")

@@ -94,7 +94,7 @@ UNITLESS_COLUMNS = frozenset({
     "bonds_intact", "peak_reached", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
     "n_grains_bonded", "n_grains_missing_final", "n_grains_deleted_debris", "grains_inside_cutter_final", "steps",
-    "final_step", "damage_step",
+    "final_step", "damage_step", "detachment_step",
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
     "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
@@ -881,6 +881,11 @@ def _cutting_summary(ts: pd.DataFrame, spec: dict[str, Any]) -> dict[str, Any]:
     for q in CUTTING_QUANTITIES:
         out[f"{q}_mean_cycles_sliding"] = (sliding.get(q, _nan()) if ecc > 0 and omega > 0
                                            else out[f"{q}_mean_steady"])
+    # indentation (seed 000 sec. 3.3): the indentation depth at the maximum (destructive) normal force, the seed's
+    # "penetration at failure"; the same row as force_normal_N_peak
+    fz = ts["force_normal_N"].to_numpy()
+    out["penetration_at_peak_normal_m"] = (float(ts["penetration_m"].iloc[int(np.argmax(np.abs(fz)))])
+                                           if out["kinematics_mode"] == "indentation" and len(fz) else _nan())
     out["contact_fraction_steady_1"] = (float((ts["force_magnitude_N"].to_numpy()[mask] > CONTACT_THRESHOLD_N).mean())
                                         if mask.any() else _nan())
     fn = out["force_normal_N_mean_steady"]

@@ -12,6 +12,7 @@ import pytest
 
 from deckgen.chips import cutter_work, detachment, find_chips, groove_area, kinematic_volume
 from deckgen.datafile import read_bonds
+from deckgen.results import UNITLESS_COLUMNS, has_unit
 from deckgen.geometry import ccs_disc, v_disc
 from helpers import load_script
 
@@ -44,10 +45,19 @@ def test_detachment_is_the_first_break_that_frees_a_piece_of_min_grains():
     assert with_side["force_side_N_destructive"] == -2.5
     assert detachment(bonds, broken, ts, min_grains=2)["detachment_step"] == 300
     none = detachment(bonds, broken, ts, min_grains=4)
-    assert none["detachment_step"] == -1 and math.isnan(none["force_normal_N_destructive"])
-    # a piece that later splits below the size still counts from when it came off (the scan is in step order)
-    split = pd.concat([broken, pd.DataFrame({"id1": [11], "id2": [12], "step": [350]})], ignore_index=True)
-    assert detachment(bonds, split, ts, min_grains=3)["detachment_step"] == 300
+    assert math.isnan(none["detachment_step"]) and math.isnan(none["force_normal_N_destructive"])
+    # every key obeys the table's unit rule (deckgen.results)
+    assert all(has_unit(k) or k in UNITLESS_COLUMNS for k in d)
+    # a break between series rows reads the last row at or before it: the branch off at step 250 -> rows up to 200
+    between = broken.assign(step=[100, 200, 250])
+    b = detachment(bonds, between, ts, min_grains=3)
+    assert b["detachment_step"] == 250 and b["force_normal_N_destructive"] == 9.0
+    assert b["penetration_at_failure_m"] == pytest.approx(2e-4)
+    # a piece that later splits below the size still counts from when it came off: the branch is off at step 100,
+    # split at 200, and four later breaks free single grains of the chain's end. A bisection over the six break
+    # steps would test step 300 (no piece of 3), search later and find none; the scan in step order finds 100.
+    seq = pd.DataFrame({"id1": [5, 12, 10, 9, 8, 7], "id2": [11, 13, 9, 8, 7, 6], "step": [100, 200, 300, 310, 320, 330]})
+    assert detachment(bonds, seq, ts, min_grains=3)["detachment_step"] == 100
 
 
 def test_two_triangles_split_into_body_and_chip():

@@ -92,8 +92,9 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     size, so the steps are scanned in order rather than bisected. Returns ``detachment_step``, the penetration then
     (``penetration_at_failure_m``), the largest F_n of the series up to that step (``force_normal_N_destructive``),
     the side force of the same row (``force_side_N_destructive``, when the series has it) and the penetration at it
-    (``penetration_at_destructive_m``); NaN (step -1) when no such piece breaks off."""
-    out: dict[str, Any] = {"detachment_step": -1, "penetration_at_failure_m": float("nan"),
+    (``penetration_at_destructive_m``); all NaN when no such piece breaks off. The forces come from the last series
+    row at or before the break-off (rows every ``outputs.series_every`` steps)."""
+    out: dict[str, Any] = {"detachment_step": float("nan"), "penetration_at_failure_m": float("nan"),
                            "force_normal_N_destructive": float("nan"), "force_side_N_destructive": float("nan"),
                            "penetration_at_destructive_m": float("nan")}
     if not len(broken) or not len(ts):
@@ -104,11 +105,12 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     for s in np.unique(steps):
         _, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
         if (np.delete(sizes, body) >= min_grains).any():
+            out["detachment_step"] = int(s)
             upto = ts[ts["step"] <= s]
-            if not len(upto):
+            if not len(upto):  # off before the first series row: no force to read
                 return out
             i = int(np.argmax(upto["force_normal_N"].to_numpy()))
-            out.update(detachment_step=int(s), penetration_at_failure_m=float(upto["penetration_m"].iloc[-1]),
+            out.update(penetration_at_failure_m=float(upto["penetration_m"].iloc[-1]),
                        force_normal_N_destructive=float(upto["force_normal_N"].iloc[i]),
                        penetration_at_destructive_m=float(upto["penetration_m"].iloc[i]))
             if "force_side_N" in upto.columns:

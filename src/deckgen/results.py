@@ -105,7 +105,7 @@ UNITLESS_COLUMNS = frozenset({
 UNIT_SUFFIXES = ("_s", "_m", "_N", "_Nm", "_Pa", "_1", "_J", "_rad", "_m2", "_m3", "_J_m3", "_m_s",
                  "_rad_s", "_per_s")
 #: Statistic suffixes after the unit (``force_normal_N_mean_steady``).
-STAT_SUFFIXES = ("_mean_steady", "_sem_steady", "_mean_cycles", "_mean_cycles_sliding", "_peak")
+STAT_SUFFIXES = ("_mean_steady", "_sem_steady", "_mean_cycles", "_mean_cycles_sliding", "_peak", "_destructive")
 
 
 def has_unit(name: str) -> bool:

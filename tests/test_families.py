@@ -1547,6 +1547,60 @@ def test_recorded_shell_held_reruns_move_the_lateral_force_and_the_fine_shell():
     assert held["change_1_ci95_high"] < held["seed_change_1"] == 1.0
 
 
+def test_recorded_indentation_family_on_three_packings_and_its_break_off():
+    """docs/families_runs/shell_held/indentation_{k202_k303,3packings} (session 49): the 12 reduced indentation cases
+    on packings 202 and 303, and with 12345 run again (identical to its session-34 runs), 36 runs. Over three packings
+    the peak F_n rises +20 % from t 15 to 25 mm (95 % -4 % to +54 %: seed 000's +100 % excluded); 12345 alone gave -7 %.
+    The whole-push peak often comes after the first piece is off (deckgen.chips.detachment): the destructive force is
+    x0.39-0.997 of it in 17 of the 24 new runs, the piece comes off at a median 1.90 mm (seed: 5-10 mm full scale =
+    1.7-3.3 mm at 1/3), and |F_s|/F_n at the destructive force (0.23 on average) is a third of the whole-push ratio."""
+    import pandas as pd
+
+    rec = ROOT / "docs" / "families_runs" / "shell_held"
+    new = pd.read_csv(rec / "indentation_k202_k303" / "family_table.csv")
+    allp = pd.read_csv(rec / "indentation_3packings" / "family_table.csv")
+    first = pd.read_csv(rec / "indentation" / "family_table.csv").set_index("case")
+    assert len(new) == 24 and sorted(set(new["packing_seed"])) == [202, 303]
+    assert len(allp) == 36 and sorted(set(allp["packing_seed"])) == [202, 303, 12345]
+    assert set(new["n_grains"]) == {4010, 4043} and new["run_completed"].all()
+    # the re-run 12345 cases are the session-34 runs again (same deck, one rank): same peaks and broken bonds
+    k = allp[allp["packing_seed"] == 12345].set_index("case")
+    assert k["force_normal_N_peak"].to_numpy() == pytest.approx(first.loc[k.index, "force_normal_N_peak"].to_numpy(), rel=1e-9)
+    assert (k["bonds_broken"] == first.loc[k.index, "bonds_broken"]).all()
+    # the break-off, on the new runs
+    r = new["force_normal_N_destructive"] / new["force_normal_N_peak"]
+    assert (r <= 1 + 1e-12).all() and int((r > 1 - 1e-9).sum()) == 7 and int((r < 0.9).sum()) == 14
+    assert r.min() == pytest.approx(0.386, abs=1e-3)
+    pf = new["penetration_at_failure_m"] * 1e3
+    assert pf.median() == pytest.approx(1.90, abs=0.01) and (pf.min(), pf.max()) == pytest.approx((1.45, 2.93), abs=0.01)
+    assert (new["penetration_at_destructive_m"] <= new["penetration_at_failure_m"] + 1e-12).all()
+    assert int((new["penetration_at_peak_normal_m"] >= 3.5e-3).sum()) == 9
+    lat_destr = new["force_side_N_destructive"].abs() / new["force_normal_N_destructive"]
+    assert lat_destr.mean() == pytest.approx(0.230, abs=1e-3) and new["lateral_to_normal_ratio_1"].mean() == pytest.approx(0.717, abs=1e-3)
+    assert (new["lateral_to_normal_ratio_1"] > 0.35).all()
+    assert sorted(new["grains_inside_cutter_final"].tolist())[-3:] == [0, 1, 2]
+    # the trends (the family's own fit, group effects rock x D)
+    def trend(path, name):
+        return pd.read_csv(path / "trends.csv").set_index("trend").loc[name]
+
+    t24, t36 = trend(rec / "indentation_k202_k303", "fn_rises_with_t"), trend(rec / "indentation_3packings", "fn_rises_with_t")
+    assert [t24["runs"], t24["change_1"], t24["p_value"]] == pytest.approx([24, 0.382, 0.023], abs=1e-3)
+    assert [t36["runs"], t36["change_1"], t36["change_1_ci95_low"], t36["change_1_ci95_high"]] == pytest.approx(
+        [36, 0.200, -0.043, 0.536], abs=1e-3)
+    assert not t36["seed_change_in_ci95"]
+    d36 = trend(rec / "indentation_3packings", "fn_rises_with_d")
+    assert d36["change_1_ci95_low"] < 0 < 0.15 < d36["change_1_ci95_high"]
+    dt24 = trend(rec / "indentation_k202_k303", "fn_destructive_rises_with_t")
+    assert [dt24["runs"], dt24["change_1"], dt24["change_1_ci95_low"], dt24["change_1_ci95_high"]] == pytest.approx(
+        [24, 0.351, -0.154, 1.542], abs=1e-3)
+    dt36 = trend(rec / "indentation_3packings", "fn_destructive_rises_with_t")
+    assert [dt36["runs"], dt36["change_1"], dt36["change_1_ci95_low"], dt36["change_1_ci95_high"], dt36["p_value"]] == \
+        pytest.approx([36, 0.453, 0.009, 1.281, 0.045], abs=1e-3)
+    assert dt36["seed_change_in_ci95"] and t36["change_1_ci95_high"] < 1.0 < dt36["change_1_ci95_high"]
+    r36 = allp["force_normal_N_destructive"] / allp["force_normal_N_peak"]
+    assert int((r36 < 0.9).sum()) == 21 and (allp["penetration_at_failure_m"].median() * 1e3) == pytest.approx(1.90, abs=0.01)
+
+
 def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
     """docs/families_runs/shell_held/linear (sessions 34-37): all 48 linear family cases rendered again on the held deck
     (every (S, p) of packings 12345, 202 and 303), each with the grains and bonds of its recorded run. No grain gets

@@ -1245,6 +1245,16 @@ def _docs_script(path: Path):
     return load_script(path)
 
 
+def _coarse_reference_row(mod, seed: int):
+    """compare.grain_pairs()'s row of packing ``seed``'s coarse r 0.16 mm reference pair, once its two case files are
+    checked to differ from packing 12345's pair by the packing seed alone (``mod``: shell_held/compare.py)."""
+    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
+    for p in ("1p9", "7p6"):
+        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k{seed}_unrel_s016.yaml",
+                                   rec / f"lin_red_s100_p{p}_unrel_s016.yaml") == {("packing", "seed"): (seed, None)}
+    return mod.grain_pairs().loc[(33, "free", seed, "coarse")]
+
+
 def _diagnostic_changes(diag_path: Path, base_path: Path | None = None) -> dict:
     """The fields in which a diagnostic case differs from its family case, name aside:
     ``{(section, field): (diagnostic value, family value)}``. The family case is ``base_path``, by default the rotary
@@ -2264,12 +2274,7 @@ def test_808_coarse_reference_and_two_stretches_of_one_cut():
     from scipy import stats
 
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
-    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    for p in ("1p9", "7p6"):
-        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k808_unrel_s016.yaml",
-                                   rec / f"lin_red_s100_p{p}_unrel_s016.yaml") == {("packing", "seed"): (808, None)}
-    t = mod.grain_pairs()
-    c8 = t.loc[(33, "free", 808, "coarse")]
+    c8 = _coarse_reference_row(mod, 808)
     assert [c8["grains p1p9"], c8["grains p7p6"]] == [2476, 2476]
     assert [c8["F_n N p1p9"], c8["F_n N p7p6"]] == pytest.approx([293.844, 153.161], abs=1e-3)
     assert [c8["largest chip grains p1p9"], c8["largest chip grains p7p6"]] == [4, 392]  # a side splits off the deep cut
@@ -2442,12 +2447,7 @@ def test_909_coarse_reference_splits_a_side_in_its_case_window():
     0.18-0.65), band over coarse x3.4 per packing (1.2-9.7) and unpaired (Welch 1.6-7.3); over the engaged stretch the
     coarse reference is x0.49 (0.29-0.84) with 909's x1.43, the first coarse stretch ratio above 1."""
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "compare.py")
-    rec = ROOT / "docs" / "families_runs" / "linear_fn_vs_p"
-    for p in ("1p9", "7p6"):
-        assert _diagnostic_changes(rec / f"lin_red_s100_p{p}_k909_unrel_s016.yaml",
-                                   rec / f"lin_red_s100_p{p}_unrel_s016.yaml") == {("packing", "seed"): (909, None)}
-    t = mod.grain_pairs()
-    c9 = t.loc[(33, "free", 909, "coarse")]
+    c9 = _coarse_reference_row(mod, 909)
     assert [c9["grains p1p9"], c9["grains p7p6"], c9["bonds broken p1p9"], c9["bonds broken p7p6"]] == [2475, 2475, 1754,
                                                                                                       3309]
     assert [c9["F_n N p1p9"], c9["F_n N p7p6"]] == pytest.approx([306.615, 243.474], abs=1e-3)

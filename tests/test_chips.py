@@ -60,6 +60,31 @@ def test_detachment_is_the_first_break_that_frees_a_piece_of_min_grains():
     assert detachment(bonds, seq, ts, min_grains=3)["detachment_step"] == 100
 
 
+def test_detachment_gives_the_first_piece_at_its_initial_place():
+    """The chain-and-branch graph of the test above, the branch 11-14 laid out along z at x = 8 mm (grain 11 at
+    z = 2 mm, then 4, 6, 8 mm; radius 1 mm), and the grains moved afterwards (the piece's place at the start counts).
+    At step 300 grains 11-13 come off (14 left at step 200): 3 grains, x and y extents one diameter (2 mm), z from
+    1 to 7 mm (6 mm), bulk volume 3 * 4/3 pi r^3 / 0.6. Without initial positions the keys are NaN."""
+    chain = [[i, i + 1] for i in range(1, 10)]
+    bonds = np.array(chain + [[5, 11], [11, 12], [12, 13], [13, 14]])
+    broken = pd.DataFrame({"id1": [10, 13, 5], "id2": [9, 14, 11], "step": [100, 200, 300]})
+    ts = pd.DataFrame({"step": [0, 100, 200, 300], "force_normal_N": [0.0, 4.0, 9.0, 3.0],
+                       "penetration_m": [0.0, 1e-4, 2e-4, 3e-4]})
+    initial = _atoms(14)
+    initial.loc[10:, "x"] = 8e-3
+    initial.loc[10:, "z"] = [2e-3, 4e-3, 6e-3, 8e-3]
+    d = detachment(bonds, broken, ts, min_grains=3, initial=initial.sample(frac=1.0, random_state=1),
+                   solid_fraction=0.6)
+    assert d["detachment_step"] == 300 and d["detached_piece_grains"] == 3
+    assert d["detached_piece_extent_x_m"] == pytest.approx(2e-3)
+    assert d["detached_piece_extent_y_m"] == pytest.approx(2e-3)
+    assert d["detached_piece_extent_z_m"] == pytest.approx(6e-3)
+    assert d["detached_piece_volume_m3"] == pytest.approx(3 * 4 / 3 * math.pi * 1e-9 / 0.6)
+    assert all(has_unit(k) or k in UNITLESS_COLUMNS for k in d)
+    bare = detachment(bonds, broken, ts, min_grains=3)
+    assert bare["detachment_step"] == 300 and math.isnan(bare["detached_piece_extent_z_m"])
+
+
 def test_two_triangles_split_into_body_and_chip():
     # grains 1-3 and 4-6 are triangles joined by the bond 3-4 (plus 7 bonded only to 6)
     bonds = np.array([[1, 2], [2, 3], [1, 3], [3, 4], [4, 5], [5, 6], [4, 6], [6, 7]])

@@ -294,9 +294,15 @@ def test_indentation_kinematics_and_contact(tmp_path, cache):
         assert summ["force_normal_N_destructive"] == pytest.approx(upto["force_normal_N"].max())
         assert summ["penetration_at_failure_m"] == pytest.approx(upto["penetration_m"].iloc[-1])
         assert summ["force_normal_N_destructive"] <= summ["force_normal_N_peak"]
+        # the first piece: as many grains as the rebuilt graph's biggest piece then, its zone inside the block
+        assert summ["detached_piece_grains"] == biggest_piece(s0)
+        blk = spec["case"]["specimen"]
+        for a, dim in zip("xyz", ("length_mm", "width_mm", "height_mm")):
+            assert 0 < summ[f"detached_piece_extent_{a}_m"] <= blk[dim] * 1e-3 + 1e-9
     else:
         assert all(biggest_piece(s) < DETACH_MIN_GRAINS for s in steps)
         assert math.isnan(summ["force_normal_N_destructive"]) and math.isnan(summ["penetration_at_failure_m"])
+        assert math.isnan(summ["detached_piece_grains"]) and math.isnan(summ["detached_piece_volume_m3"])
 
 
 def test_rotary_path_moves_the_shell_rigidly(tmp_path, cache):

@@ -81,8 +81,40 @@ def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> t
 DETACH_MIN_GRAINS = 25
 
 
+#: the first piece's columns (:func:`detachment` with the grains' initial positions)
+PIECE_KEYS = ("detached_piece_grains", "detached_piece_volume_m3", "detached_piece_extent_x_m",
+              "detached_piece_extent_y_m", "detached_piece_extent_z_m")
+
+
+def initial_positions(run_dir: Path) -> pd.DataFrame | None:
+    """The grains' positions at the start of the run (id, type, radius, x, y, z): the Atoms section of
+    ``specimen.data`` (atom_style bpm/sphere: id molecule type diameter density x y z, as deckgen writes it), else the
+    step-0 frame of atoms.dump.gz; None when neither is there."""
+    from deckgen.datafile import iter_section
+    from deckgen.parse.common import ParseError
+
+    data = run_dir / "specimen.data"
+    if data.is_file():
+        rows = []
+        for lineno, parts in iter_section(data, "Atoms"):
+            if len(parts) < 8:
+                raise ParseError(data, lineno, f"bpm/sphere atom line needs 8 columns (id molecule type diameter "
+                                 f"density x y z), got {len(parts)}")
+            try:
+                rows.append((int(parts[0]), int(parts[2]), 0.5 * float(parts[3]), *map(float, parts[5:8])))
+            except ValueError:
+                raise ParseError(data, lineno, "non-numeric value in atom line") from None
+        return pd.DataFrame(rows, columns=["id", "type", "radius", "x", "y", "z"])
+    dump = run_dir / "atoms.dump.gz"
+    if dump.is_file():
+        for frame in iter_frames(dump, ["id", "type", "radius", "x", "y", "z"]):
+            return frame.data.reset_index(drop=True) if frame.timestep == 0 else None
+    return None
+
+
 def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
-               min_grains: int = DETACH_MIN_GRAINS) -> dict[str, Any]:
+               min_grains: int = DETACH_MIN_GRAINS, initial: pd.DataFrame | None = None,
+               solid_fraction: float | None = None) -> dict[str, Any]:
     """The chip's break-off in an indentation run. Seed 000 pushes the disc "until the material was detached
     entirely" and reports the maximum (destructive) normal force; a reduced run pushes a fixed depth, so its peak over
     the whole push can come after the chip is off, from the disc pressing on into the block.
@@ -93,19 +125,28 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     (``penetration_at_failure_m``), the largest F_n of the series up to that step (``force_normal_N_destructive``),
     the side force of the same row (``force_side_N_destructive``, when the series has it) and the penetration at it
     (``penetration_at_destructive_m``); all NaN when no such piece breaks off. The forces come from the last series
-    row at or before the break-off (rows every ``outputs.series_every`` steps)."""
+    row at or before the break-off (rows every ``outputs.series_every`` steps).
+
+    With ``initial`` (the grains' positions at the start: id, radius, x, y, z; :func:`initial_positions`) and the
+    packing's ``solid_fraction`` it also gives the first piece (the largest component other than the body at the
+    break-off): its grains (``detached_piece_grains``), bulk volume (solid / solid fraction, as :func:`find_chips`)
+    and extents along x, y and z of its grains' spheres at their INITIAL positions, i.e. the zone of the block the
+    piece came from (seed 000's "destruction zone dimensions"), not where it flew to. NaN without a piece or without
+    ``initial``."""
     out: dict[str, Any] = {"detachment_step": float("nan"), "penetration_at_failure_m": float("nan"),
                            "force_normal_N_destructive": float("nan"), "force_side_N_destructive": float("nan"),
-                           "penetration_at_destructive_m": float("nan")}
+                           "penetration_at_destructive_m": float("nan"), **{k: float("nan") for k in PIECE_KEYS}}
     if not len(broken) or not len(ts):
         return out
     ids = np.unique(bonds)
     steps = broken["step"].to_numpy(np.int64)
     pairs = broken[["id1", "id2"]].to_numpy(np.int64)
     for s in np.unique(steps):
-        _, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
+        label, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
         if (np.delete(sizes, body) >= min_grains).any():
             out["detachment_step"] = int(s)
+            if initial is not None and solid_fraction:
+                out.update(_piece(ids, label, sizes, body, initial, float(solid_fraction)))
             upto = ts[ts["step"] <= s]
             if not len(upto):  # off before the first series row: no force to read
                 return out
@@ -117,6 +158,20 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
                 out["force_side_N_destructive"] = float(upto["force_side_N"].iloc[i])
             return out
     return out
+
+
+def _piece(ids: np.ndarray, label: np.ndarray, sizes: np.ndarray, body: int, initial: pd.DataFrame,
+           solid_fraction: float) -> dict[str, float]:
+    """The largest component other than ``body``: grains, bulk volume and extents at the ``initial`` positions."""
+    others = np.where(np.arange(len(sizes)) != body, sizes, -1)
+    sel_ids = ids[label == int(np.argmax(others))]
+    g = initial.set_index("id").loc[sel_ids]
+    r = g["radius"].to_numpy(float)
+    x = g[["x", "y", "z"]].to_numpy(float)
+    ext = (x + r[:, None]).max(axis=0) - (x - r[:, None]).min(axis=0)
+    return {"detached_piece_grains": int(len(sel_ids)),
+            "detached_piece_volume_m3": float((4.0 / 3.0 * math.pi * r**3).sum()) / solid_fraction,
+            **{f"detached_piece_extent_{a}_m": float(e) for a, e in zip("xyz", ext)}}
 
 
 def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid_fraction: float,
@@ -239,7 +294,7 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
     if derived.get("kinematics_mode") == "indentation":
-        out.update(detachment(bonds, broken, ts))
+        out.update(detachment(bonds, broken, ts, initial=initial_positions(run_dir), solid_fraction=phi))
     out.update({
         "cutter_work_J": work,
         "kinematic_volume_m3": v_kin,

@@ -853,7 +853,8 @@ TABLE_FIELDS = [
     "largest_chip_extent_y_m", "largest_chip_extent_z_m", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
     "specific_energy_kinematic_J_m3", "grains_inside_cutter_final", "n_grains_deleted_debris",
     "penetration_at_peak_normal_m", "force_normal_N_destructive", "force_side_N_destructive", "penetration_at_destructive_m",
-    "penetration_at_failure_m", "detachment_step",
+    "penetration_at_failure_m", "detachment_step", "detached_piece_grains", "detached_piece_volume_m3",
+    "detached_piece_extent_x_m", "detached_piece_extent_y_m", "detached_piece_extent_z_m",
 ]
 
 

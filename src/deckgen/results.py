@@ -94,7 +94,7 @@ UNITLESS_COLUMNS = frozenset({
     "bonds_intact", "peak_reached", "bonds_broken", "bonds_broken_tension", "bonds_broken_shear",
     "bonds_broken_unknown", "bonds_initial", "bonds_final", "n_grains", "n_bonds_initial",
     "n_grains_bonded", "n_grains_missing_final", "n_grains_deleted_debris", "grains_inside_cutter_final", "steps",
-    "final_step", "damage_step", "detachment_step",
+    "final_step", "damage_step", "detachment_step", "detached_piece_grains",
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
     "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",

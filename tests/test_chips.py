@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from deckgen.chips import cutter_work, detachment, find_chips, groove_area, kinematic_volume
+from deckgen.chips import cutter_work, detachment, find_chips, groove_area, initial_positions, kinematic_volume
 from deckgen.datafile import read_bonds
 from deckgen.results import UNITLESS_COLUMNS, has_unit
 from deckgen.geometry import ccs_disc, v_disc
@@ -80,9 +80,49 @@ def test_detachment_gives_the_first_piece_at_its_initial_place():
     assert d["detached_piece_extent_y_m"] == pytest.approx(2e-3)
     assert d["detached_piece_extent_z_m"] == pytest.approx(6e-3)
     assert d["detached_piece_volume_m3"] == pytest.approx(3 * 4 / 3 * math.pi * 1e-9 / 0.6)
+    assert [d[f"detached_piece_min_{a}_m"] for a in "xyz"] == pytest.approx([7e-3, -1e-3, 1e-3])
+    assert [d[f"detached_piece_max_{a}_m"] for a in "xyz"] == pytest.approx([9e-3, 1e-3, 7e-3])
     assert all(has_unit(k) or k in UNITLESS_COLUMNS for k in d)
     bare = detachment(bonds, broken, ts, min_grains=3)
     assert bare["detachment_step"] == 300 and math.isnan(bare["detached_piece_extent_z_m"])
+    with pytest.raises(ValueError, match="lack 1 bonded grains"):
+        detachment(bonds, broken, ts, min_grains=3, initial=initial[initial["id"] != 12], solid_fraction=0.6)
+
+
+def test_initial_positions_read_a_bpm_data_file_and_else_the_step_0_dump(tmp_path):
+    """deckgen's bpm/sphere data file (id molecule type diameter density x y z) read back: radius = diameter / 2, the
+    types kept (a type-2 shell sphere included), positions exact; without it the step-0 frame of atoms.dump.gz; a later
+    first frame or no file gives None; a short atom line is a ParseError naming the file and line."""
+    from deckgen.datafile import write_bpm_data
+    from deckgen.parse.common import ParseError
+
+    x = np.array([[1e-3, 2e-3, 3e-3], [4e-3, -5e-3, 6e-3], [7e-3, 8e-3, -9e-3]])
+    write_bpm_data(tmp_path / "specimen.data", title="t", box=np.array([[-1e-2, 1e-2]] * 3),
+                   types=np.array([1, 1, 2]), radius=np.array([0.7e-3, 0.9e-3, 0.3e-3]),
+                   density=np.full(3, 2000.0), x=x, n_atom_types=2, bonds=np.array([[0, 1]]),
+                   bond_types=np.array([1]), n_bond_types=1)
+    a = initial_positions(tmp_path)
+    assert a["id"].tolist() == [1, 2, 3] and a["type"].tolist() == [1, 1, 2]
+    assert a["radius"].to_numpy() == pytest.approx([0.7e-3, 0.9e-3, 0.3e-3], rel=1e-9)
+    assert a[["x", "y", "z"]].to_numpy() == pytest.approx(x, rel=1e-9)
+    dump = tmp_path / "d"
+    dump.mkdir()
+    frame = ("ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS pp pp pp\n-1 1\n-1 1\n-1 1\n"
+             "ITEM: ATOMS id type radius x y z\n7 1 0.001 0.1 0.2 0.3\n8 1 0.002 0.4 0.5 0.6\n")
+    import gzip
+
+    with gzip.open(dump / "atoms.dump.gz", "wt") as fh:
+        fh.write(frame.format(step=0) + frame.format(step=100))
+    b = initial_positions(dump)
+    assert b["id"].tolist() == [7, 8] and b["radius"].tolist() == [0.001, 0.002] and b["z"].tolist() == [0.3, 0.6]
+    with gzip.open(dump / "atoms.dump.gz", "wt") as fh:
+        fh.write(frame.format(step=100))
+    assert initial_positions(dump) is None and initial_positions(tmp_path / "none") is None
+    text = (tmp_path / "specimen.data").read_text().replace("2 0 1 ", "2 0 ", 1)
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "specimen.data").write_text(text)
+    with pytest.raises(ParseError, match=r"specimen.data:\d+: bpm/sphere atom line needs 8 columns"):
+        initial_positions(tmp_path / "bad")
 
 
 def test_two_triangles_split_into_body_and_chip():

@@ -82,8 +82,8 @@ DETACH_MIN_GRAINS = 25
 
 
 #: the first piece's columns (:func:`detachment` with the grains' initial positions)
-PIECE_KEYS = ("detached_piece_grains", "detached_piece_volume_m3", "detached_piece_extent_x_m",
-              "detached_piece_extent_y_m", "detached_piece_extent_z_m")
+PIECE_KEYS = ("detached_piece_grains", "detached_piece_volume_m3",
+              *(f"detached_piece_{what}_{a}_m" for what in ("extent", "min", "max") for a in "xyz"))
 
 
 def initial_positions(run_dir: Path) -> pd.DataFrame | None:
@@ -130,7 +130,8 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     With ``initial`` (the grains' positions at the start: id, radius, x, y, z; :func:`initial_positions`) and the
     packing's ``solid_fraction`` it also gives the first piece (the largest component other than the body at the
     break-off): its grains (``detached_piece_grains``), bulk volume (solid / solid fraction, as :func:`find_chips`)
-    and extents along x, y and z of its grains' spheres at their INITIAL positions, i.e. the zone of the block the
+    and extents along x, y and z of its grains' spheres at their INITIAL positions (``detached_piece_extent_*_m``,
+    with the box's corners ``detached_piece_min_*_m`` and ``detached_piece_max_*_m``), i.e. the zone of the block the
     piece came from (seed 000's "destruction zone dimensions"), not where it flew to. NaN without a piece or without
     ``initial``."""
     out: dict[str, Any] = {"detachment_step": float("nan"), "penetration_at_failure_m": float("nan"),
@@ -165,13 +166,20 @@ def _piece(ids: np.ndarray, label: np.ndarray, sizes: np.ndarray, body: int, ini
     """The largest component other than ``body``: grains, bulk volume and extents at the ``initial`` positions."""
     others = np.where(np.arange(len(sizes)) != body, sizes, -1)
     sel_ids = ids[label == int(np.argmax(others))]
-    g = initial.set_index("id").loc[sel_ids]
+    g = initial.set_index("id")
+    missing = np.setdiff1d(sel_ids, g.index.to_numpy())
+    if len(missing):
+        raise ValueError(f"the initial positions lack {len(missing)} bonded grains of the first piece (ids "
+                         f"{missing[:5].tolist()}...) (fix: pass the step-0 positions of every bonded grain)")
+    g = g.loc[sel_ids]
     r = g["radius"].to_numpy(float)
     x = g[["x", "y", "z"]].to_numpy(float)
-    ext = (x + r[:, None]).max(axis=0) - (x - r[:, None]).min(axis=0)
+    lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
     return {"detached_piece_grains": int(len(sel_ids)),
             "detached_piece_volume_m3": float((4.0 / 3.0 * math.pi * r**3).sum()) / solid_fraction,
-            **{f"detached_piece_extent_{a}_m": float(e) for a, e in zip("xyz", ext)}}
+            **{f"detached_piece_extent_{a}_m": float(e) for a, e in zip("xyz", hi - lo)},
+            **{f"detached_piece_min_{a}_m": float(e) for a, e in zip("xyz", lo)},
+            **{f"detached_piece_max_{a}_m": float(e) for a, e in zip("xyz", hi)}}
 
 
 def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid_fraction: float,

@@ -825,7 +825,8 @@ def family_files(root: Path) -> dict[Path, str]:
 PLOTS: dict[str, tuple[str, list[str], list[str]]] = {
     "indentation_asymmetric": ("cut_spacing_mm", ["rock", "disc_diameter_mm"],
                                ["force_normal_N_peak", "force_normal_N_destructive", "lateral_to_normal_ratio_1",
-                                "penetration_at_failure_m"]),
+                                "lateral_to_normal_ratio_destructive_1", "penetration_at_failure_m",
+                                "detached_piece_volume_m3"]),
     "linear_ccs": ("penetration_mm", ["spacing_mm"], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
                                                      "rolling_to_normal_ratio_1"]),
     "rotary": ("rotary_radius_mm", [], ["force_normal_N_mean_steady", "force_rolling_N_mean_steady",
@@ -854,7 +855,7 @@ TABLE_FIELDS = [
     "specific_energy_kinematic_J_m3", "grains_inside_cutter_final", "n_grains_deleted_debris",
     "penetration_at_peak_normal_m", "force_normal_N_destructive", "force_side_N_destructive", "penetration_at_destructive_m",
     "penetration_at_failure_m", "detachment_step", "detached_piece_grains", "detached_piece_volume_m3",
-    "detached_piece_extent_x_m", "detached_piece_extent_y_m", "detached_piece_extent_z_m",
+    *(f"detached_piece_{what}_{a}_m" for what in ("extent", "min", "max") for a in "xyz"),
 ]
 
 
@@ -964,15 +965,18 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             row["cycles_in_window_1"] = (float(s["steady_end_s"]) - float(s["steady_start_s"])) * float(s["omega_rad_s"]) / (2 * math.pi)
         except (KeyError, TypeError, ValueError):
             row["cycles_in_window_1"] = float("nan")
-        fn, fs = row["force_normal_N_peak"], row["force_side_N_peak"]
-        try:
-            row["lateral_to_normal_ratio_1"] = abs(float(fs)) / abs(float(fn))
-        except (TypeError, ValueError, ZeroDivisionError):
-            row["lateral_to_normal_ratio_1"] = float("nan")
+        # |F_s|/F_n of the whole-push peaks and, for indentation, at the destructive force (the break-off's row)
+        for col, fn_key, fs_key in (("lateral_to_normal_ratio_1", "force_normal_N_peak", "force_side_N_peak"),
+                                    ("lateral_to_normal_ratio_destructive_1", "force_normal_N_destructive",
+                                     "force_side_N_destructive")):
+            try:
+                row[col] = abs(float(row[fs_key])) / abs(float(row[fn_key]))
+            except (TypeError, ValueError, ZeroDivisionError):
+                row[col] = float("nan")
         rows.append({"case": s["case"], **row})
     extra = ["variant_case", *(c for c, _, _ in VARIANT_FIELDS)] if variants else []
     runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1",
-                                       *extra])
+                                       "lateral_to_normal_ratio_destructive_1", *extra])
     if variants and runs["case"].duplicated().any():
         dup = sorted(runs.loc[runs["case"].duplicated(keep=False), "variant_case"])
         raise ValueError(f"{', '.join(dup)}: variants of one family case in one report (fix: one variant per report)")

@@ -43,6 +43,27 @@ def per_run(table: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+#: the family's reduced block (x length, y width, z height) in mm; the free face is y = -width / 2
+BLOCK_MM = (100 / 3, 25.0, 20.0)
+#: a face within this of a piece's zone (its grains' spheres at their initial places) counts as touched
+TOUCH_MM = 0.25
+#: the base is held by freezing the grains whose centres lie within 2 r_max (1.98 mm here) of it (the deck's fix_zmin
+#: region), so a free piece's spheres reach down to about 1 mm only: a piece whose zone comes within the held layer's
+#: thickness of the base counts as reaching it
+BASE_MM = 2.0
+
+
+def touches(table: pd.DataFrame, block_mm: tuple[float, float, float] = BLOCK_MM) -> pd.DataFrame:
+    """Which faces of the block each run's first piece touches: the free face (y min), the top (z max, pushed), an
+    x end (either; free faces), the held base layer (z min, :data:`BASE_MM`) and the fixed back face (y max)."""
+    length, width, height = block_mm
+    lo = {a: table[f"detached_piece_min_{a}_m"] * 1e3 for a in "xyz"}
+    hi = {a: table[f"detached_piece_max_{a}_m"] * 1e3 for a in "xyz"}
+    return pd.DataFrame({"free_face": lo["y"] <= -width / 2 + TOUCH_MM, "top": hi["z"] >= height - TOUCH_MM,
+                         "x_end": (lo["x"] <= TOUCH_MM) | (hi["x"] >= length - TOUCH_MM),
+                         "base": lo["z"] <= BASE_MM, "back": hi["y"] >= width / 2 - TOUCH_MM})
+
+
 def pairs_above(table: pd.DataFrame, column: str) -> tuple[int, int, float]:
     """Matched (D, t, packing) pairs where sandstone's ``column`` is above concrete's: count, pairs, median ratio."""
     p = table.pivot_table(index=PAIR, columns="rock", values=column)
@@ -71,6 +92,8 @@ def main(argv: list[str] | None = None) -> None:
     print(f"\nfirst piece: median largest extent / t {runs['largest_extent_over_t_1'].median():.2f}; medians x, y, z / t "
           + ", ".join(f"{runs[f'extent_{a}_over_t_1'].median():.2f}" for a in "xyz")
           + f"; largest along x in {int((runs['largest_axis'] == 'x').sum())} of {len(runs)}")
+    faces = touches(table).assign(t=table["cut_spacing_full_mm"])
+    print("first pieces touching each face of the block, by t:\n" + faces.groupby("t").sum().to_string())
     for col in ("detached_piece_volume_m3", "removed_volume_m3"):
         n, of, med = pairs_above(table, col)
         print(f"sandstone above concrete, {col}: {n} of {of} pairs (median ratio {med:.2f})")

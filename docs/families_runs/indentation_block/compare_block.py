@@ -1,0 +1,101 @@
+"""The reduced indentation cases on a larger block against the same cases on the family's block (session 50).
+
+The nine concrete D 150 mm family cases (t 15/20/25 mm, packings 12345, 202, 303) were run on a block 50 x 25 x 30 mm
+(``*_big.yaml`` here: x and z x1.5) besides the family's 33.3 x 25 x 20 mm. This reads the two recorded family tables
+(``report/family_table.csv`` of the big runs, made with ``deckgen.families report --variants``, and
+``shell_held/indentation_3packings/family_table.csv``) and gives, per case, both blocks' peak and destructive F_n,
+penetration at failure and first piece (grains, volume, extents, and whether its zone touches a face of its block),
+then the big/small ratios (geometric means with a t interval over the nine cases) and the destructive F_n's change
+with t on each block (OLS with the packing as group).
+
+The packings of the two blocks share no grain position (the larger block is packed anew from the same seed), so a
+ratio mixes the block's effect with a packing's scatter.
+
+    python docs/families_runs/indentation_block/compare_block.py
+"""
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import statsmodels.formula.api as smf
+from scipy import stats
+
+from deckgen.scriptload import load_script
+
+HERE = Path(__file__).resolve().parent
+BIG = HERE / "report" / "family_table.csv"
+SMALL = HERE.parent / "shell_held" / "indentation_3packings" / "family_table.csv"
+#: block size (x length, y width, z height) in mm, by the block's label
+BLOCKS = {"small": (100 / 3, 25.0, 20.0), "big": (50.0, 25.0, 30.0)}
+PIECES = load_script(HERE.parent / "shell_held" / "indentation_pieces.py")
+QUANTITIES = ("force_normal_N_peak", "force_normal_N_destructive", "penetration_at_failure_m", "detached_piece_grains",
+              "detached_piece_volume_m3", "removed_volume_m3")
+
+
+def paired(big: pd.DataFrame, small: pd.DataFrame) -> pd.DataFrame:
+    """One row per case: both blocks' quantities (``_big``, ``_small``) and which faces the pieces touch."""
+    b = big.assign(case=big["case"].str.removesuffix("_big")) if "variant_case" not in big else big
+    b = b.set_index("case")
+    s = small.set_index("case").loc[b.index]
+    out = pd.DataFrame({"cut_spacing_full_mm": b["cut_spacing_full_mm"], "packing_seed": b["packing_seed"]})
+    for q in QUANTITIES:
+        out[f"{q}_big"], out[f"{q}_small"] = b[q], s[q]
+    for block, t in (("big", b), ("small", s)):
+        tt = PIECES.touches(t.reset_index(), BLOCKS[block])
+        tt.index = t.index
+        for c in tt.columns:
+            out[f"touches_{c}_{block}"] = tt[c]
+    return out.reset_index()
+
+
+def ratio(p: pd.DataFrame, q: str) -> dict[str, float]:
+    """Geometric mean of big/small over the cases with its t 95 % interval, and how many are above 1."""
+    r = np.log(p[f"{q}_big"] / p[f"{q}_small"])
+    n = len(r)
+    half = stats.t.ppf(0.975, n - 1) * r.std(ddof=1) / math.sqrt(n)
+    return {"geometric_mean": float(np.exp(r.mean())), "ci95_low": float(np.exp(r.mean() - half)),
+            "ci95_high": float(np.exp(r.mean() + half)), "above_1": int((r > 0).sum()), "cases": n}
+
+
+def t_change(table: pd.DataFrame, y: str) -> dict[str, float]:
+    """OLS of ``y`` on the seed's t with the packing as group: slope per mm of t, p, and the change from t 15 to 25 mm
+    (mean fitted values; NaN where the fitted mean at 15 mm is not positive, so that a ratio has no scale)."""
+    f = smf.ols(f"{y} ~ cut_spacing_full_mm + C(packing_seed)", data=table).fit()
+    m15 = f.predict(table.assign(cut_spacing_full_mm=15)).mean()
+    m25 = f.predict(table.assign(cut_spacing_full_mm=25)).mean()
+    return {"slope_per_mm": float(f.params["cut_spacing_full_mm"]), "p_value": float(f.pvalues["cut_spacing_full_mm"]),
+            "change_1": float(m25 / m15 - 1) if m15 > 0 else float("nan"), "runs": int(f.nobs)}
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.parse_args(argv)
+    big, small = pd.read_csv(BIG), pd.read_csv(SMALL)
+    p = paired(big, small)
+    pd.set_option("display.width", 250)
+    show = ["case"] + [f"{q}_{b}" for q in QUANTITIES[:4] for b in ("small", "big")]
+    print(p[show].round(4).to_string(index=False))
+    print()
+    for q in QUANTITIES:
+        r = ratio(p, q)
+        print(f"{q}: big/small x{r['geometric_mean']:.2f} (95 % {r['ci95_low']:.2f}-{r['ci95_high']:.2f}), "
+              f"above 1 in {r['above_1']} of {r['cases']}")
+    for block in ("small", "big"):
+        print(f"{block} block, first pieces touching: " + ", ".join(
+            f"{c} {int(p[f'touches_{c}_{block}'].sum())}" for c in ("free_face", "top", "x_end", "base", "back")))
+    nine = small.set_index("case").loc[p["case"]].reset_index()
+    for name, t in (("small", nine), ("big", big)):
+        for y in ("force_normal_N_destructive", "force_normal_N_peak", "detached_piece_volume_m3"):
+            c = t_change(t, y)
+            means = t.groupby("cut_spacing_full_mm")[y].mean()
+            print(f"{name} block, {y} with t: {c['change_1']:+.0%}, slope {c['slope_per_mm']:.3g} per mm "
+                  f"(p {c['p_value']:.3g}, {c['runs']} runs); means at t 15/20/25: "
+                  + " / ".join(f"{v:.4g}" for v in means))
+
+
+if __name__ == "__main__":
+    main()

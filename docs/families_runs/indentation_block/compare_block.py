@@ -71,6 +71,25 @@ def t_change(table: pd.DataFrame, y: str) -> dict[str, float]:
             "change_1": float(m25 / m15 - 1) if m15 > 0 else float("nan"), "runs": int(f.nobs)}
 
 
+def family_fits(table: pd.DataFrame) -> pd.DataFrame:
+    """The family's own trend fits (deckgen.families.trend_table: group effects rock x D, here one group) of the
+    peak and destructive F_n with t: runs, change from t 15 to 25 mm with its 95 % interval, p."""
+    from deckgen.families import trend_table
+
+    fit = trend_table("indentation_asymmetric", table).set_index("trend")
+    return fit.loc[["fn_rises_with_t", "fn_destructive_rises_with_t"],
+                   ["runs", "change_1", "change_1_ci95_low", "change_1_ci95_high", "p_value"]]
+
+
+def block_t_interaction(big: pd.DataFrame, nine: pd.DataFrame, y: str, log: bool = False) -> float:
+    """p of the block x t interaction: does ``y`` (its log with ``log``) change with t differently on the two blocks
+    (OLS over both blocks' runs, y ~ t * block)?"""
+    both = pd.concat([nine.assign(block="small"), big.assign(block="big")], ignore_index=True)
+    both["y"] = np.log(both[y]) if log else both[y]
+    f = smf.ols("y ~ cut_spacing_full_mm * C(block)", data=both).fit()
+    return float(f.pvalues["cut_spacing_full_mm:C(block)[T.small]"])
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.parse_args(argv)
@@ -88,6 +107,17 @@ def main(argv: list[str] | None = None) -> None:
         print(f"{block} block, first pieces touching: " + ", ".join(
             f"{c} {int(p[f'touches_{c}_{block}'].sum())}" for c in ("free_face", "top", "x_end", "base", "back")))
     nine = small.set_index("case").loc[p["case"]].reset_index()
+    for name, t in (("small", nine), ("big", big)):
+        print(f"{name} block, family trend fits (rock x D groups):\n{family_fits(t).round(3).to_string()}")
+        print(f"{name} block, mean abs(F_s)/F_n at the destructive force "
+              f"{t['lateral_to_normal_ratio_destructive_1'].mean():.2f}; destructive F_n = whole-push peak in "
+              f"{int((t['force_normal_N_destructive'] >= t['force_normal_N_peak']).sum())} of {len(t)}")
+    still = big[(big["detached_piece_min_x_m"] * 1e3 <= PIECES.TOUCH_MM)
+                | (big["detached_piece_max_x_m"] * 1e3 >= BLOCKS["big"][0] - PIECES.TOUCH_MM)]
+    print(f"big block without its run(s) whose piece reaches an x end ({', '.join(still['variant_case'])}):\n"
+          + family_fits(big.drop(still.index)).round(3).to_string())
+    print(f"block x t interaction p: destructive F_n {block_t_interaction(big, nine, 'force_normal_N_destructive'):.2f}, "
+          f"log first-piece volume {block_t_interaction(big, nine, 'detached_piece_volume_m3', log=True):.3f}")
     for name, t in (("small", nine), ("big", big)):
         for y in ("force_normal_N_destructive", "force_normal_N_peak", "detached_piece_volume_m3"):
             c = t_change(t, y)

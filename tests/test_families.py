@@ -1669,7 +1669,8 @@ def test_recorded_indentation_on_a_larger_block_frees_the_first_piece_and_keeps_
     import pandas as pd
 
     mod = _docs_script(ROOT / "docs" / "families_runs" / "indentation_block" / "compare_block.py")
-    big, small = pd.read_csv(mod.BIG), pd.read_csv(mod.SMALL)
+    big_all, small = pd.read_csv(mod.BIG), pd.read_csv(mod.SMALL)
+    big = big_all[big_all["disc_diameter_full_mm"] == 150].reset_index(drop=True)
     assert len(big) == 9 and set(big["block_height_mm"]) == {30.0} and big["run_completed"].all()
     assert sorted(set(big["n_grains"])) == [8999, 9064, 9083] and (big["grains_inside_cutter_final"] == 0).all()
     assert big["wall_s"].between(7.5 * 60, 9.0 * 60).all()
@@ -1708,10 +1709,30 @@ def test_recorded_indentation_on_a_larger_block_frees_the_first_piece_and_keeps_
     assert [f8["runs"], f8["change_1"], f8["p_value"]] == pytest.approx([8, 0.527, 0.034], abs=1e-3)
     assert int((big["force_normal_N_destructive"] >= big["force_normal_N_peak"]).sum()) == 2
     assert mod.t_change(big, "force_normal_N_peak")["change_1"] == pytest.approx(-0.14, abs=0.005)
-    fam = pd.read_csv(mod.BIG.parent / "trends.csv").set_index("trend").loc["fn_destructive_rises_with_t"]
-    assert [fam["runs"], fam["change_1"], fam["change_1_ci95_low"], fam["change_1_ci95_high"], fam["p_value"]] == \
-        pytest.approx([9, 0.867, 0.119, 2.429, 0.023], abs=1e-3)
-    assert fam["seed_change_in_ci95"]
+    assert [fb["change_1"], fb["change_1_ci95_low"], fb["change_1_ci95_high"], fb["p_value"]] == pytest.approx(
+        [0.867, 0.119, 2.429, 0.023], abs=1e-3)
+    # D 160 mm on the larger block too (18 runs): one run (t 25 mm, packing 303) frees no piece of 25 grains in the push
+    # (largest chip 7 grains; 2 grains inside the shell); the destructive rise holds on both blocks and D
+    d160 = big_all[big_all["disc_diameter_full_mm"] == 160]
+    assert len(d160) == 9 and d160["wall_s"].between(7.0 * 60, 8.2 * 60).all()
+    none = d160[d160["detachment_step"].isna()]
+    assert none["variant_case"].tolist() == ["ind_red_concrete_d160_t25_k303_big"] and int(none["largest_chip_grains"].iloc[0]) == 7
+    assert big_all["grains_inside_cutter_final"].sum() == 2 == int(none["grains_inside_cutter_final"].iloc[0])
+    p160 = mod.paired(d160, small)
+    assert int(p160["touches_x_end_big"].sum()) == 0 and int(p160["touches_x_end_small"].sum()) == 4
+    fam = pd.read_csv(mod.BIG.parent / "trends.csv").set_index("trend")
+    ft, fd = fam.loc["fn_destructive_rises_with_t"], fam.loc["fn_destructive_rises_with_d"]
+    assert [ft["runs"], ft["change_1"], ft["change_1_ci95_low"], ft["change_1_ci95_high"], ft["p_value"]] == \
+        pytest.approx([17, 0.817, 0.321, 1.564, 0.001], abs=1e-3)
+    assert ft["seed_change_in_ci95"] and fd["change_1_ci95_low"] < 0 < fd["change_1_ci95_high"]
+    assert not fam.loc["fn_rises_with_t", "seed_change_in_ci95"] and fam.loc["fn_rises_with_t", "change_1"] == pytest.approx(-0.095, abs=1e-3)
+    small18 = small.set_index("case").loc[mod.paired(big_all, small)["case"]].reset_index()
+    fs18 = mod.family_fits(small18).loc["fn_destructive_rises_with_t"]
+    assert [fs18["runs"], fs18["change_1"], fs18["change_1_ci95_low"], fs18["change_1_ci95_high"]] == pytest.approx(
+        [18, 0.678, 0.182, 1.466], abs=1e-3)
+    assert mod.block_t_interaction(big_all, small18, "force_normal_N_destructive") == pytest.approx(0.85, abs=0.005)
+    r18 = mod.ratio(mod.paired(big_all.dropna(subset=["detachment_step"]), small), "force_normal_N_destructive")
+    assert [r18["geometric_mean"], r18["ci95_low"], r18["ci95_high"], r18["cases"]] == pytest.approx([0.81, 0.67, 0.96, 17], abs=0.01)
 
 
 def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():

@@ -54,17 +54,22 @@ def paired(big: pd.DataFrame, small: pd.DataFrame) -> pd.DataFrame:
 
 def ratio(p: pd.DataFrame, q: str) -> dict[str, float]:
     """Geometric mean of big/small over the cases with its t 95 % interval, and how many are above 1."""
-    r = np.log(p[f"{q}_big"] / p[f"{q}_small"])
+    r = np.log(p[f"{q}_big"] / p[f"{q}_small"]).dropna()  # a run without a break-off has no destructive force
     n = len(r)
     half = stats.t.ppf(0.975, n - 1) * r.std(ddof=1) / math.sqrt(n)
     return {"geometric_mean": float(np.exp(r.mean())), "ci95_low": float(np.exp(r.mean() - half)),
             "ci95_high": float(np.exp(r.mean() + half)), "above_1": int((r > 0).sum()), "cases": n}
 
 
+def _d_term(table: pd.DataFrame) -> str:
+    """The disc diameter as a group term of a fit, when the runs have more than one."""
+    return " + C(disc_diameter_full_mm)" if table["disc_diameter_full_mm"].nunique() > 1 else ""
+
+
 def t_change(table: pd.DataFrame, y: str) -> dict[str, float]:
-    """OLS of ``y`` on the seed's t with the packing as group: slope per mm of t, p, and the change from t 15 to 25 mm
+    """OLS of ``y`` on the seed's t with the packing (and D, when there are two) as group: slope per mm of t, p, and the change from t 15 to 25 mm
     (mean fitted values; NaN where the fitted mean at 15 mm is not positive, so that a ratio has no scale)."""
-    f = smf.ols(f"{y} ~ cut_spacing_full_mm + C(packing_seed)", data=table).fit()
+    f = smf.ols(f"{y} ~ cut_spacing_full_mm + C(packing_seed){_d_term(table)}", data=table).fit()
     m15 = f.predict(table.assign(cut_spacing_full_mm=15)).mean()
     m25 = f.predict(table.assign(cut_spacing_full_mm=25)).mean()
     return {"slope_per_mm": float(f.params["cut_spacing_full_mm"]), "p_value": float(f.pvalues["cut_spacing_full_mm"]),
@@ -83,17 +88,32 @@ def family_fits(table: pd.DataFrame) -> pd.DataFrame:
 
 def block_t_interaction(big: pd.DataFrame, nine: pd.DataFrame, y: str, log: bool = False) -> float:
     """p of the block x t interaction: does ``y`` (its log with ``log``) change with t differently on the two blocks
-    (OLS over both blocks' runs, y ~ t * block)?"""
+    (OLS over both blocks' runs, y ~ t * block, with D as a group when there are two)?"""
     both = pd.concat([nine.assign(block="small"), big.assign(block="big")], ignore_index=True)
     both["y"] = np.log(both[y]) if log else both[y]
-    f = smf.ols("y ~ cut_spacing_full_mm * C(block)", data=both).fit()
+    f = smf.ols(f"y ~ cut_spacing_full_mm * C(block){_d_term(both)}", data=both).fit()
     return float(f.pvalues["cut_spacing_full_mm:C(block)[T.small]"])
+
+
+def subsets(big: pd.DataFrame) -> dict[str, pd.DataFrame]:
+    """The big-block runs by disc diameter, and all of them."""
+    out = {f"D {d:g} mm": g for d, g in big.groupby("disc_diameter_full_mm")}
+    if len(out) > 1:
+        out["both D"] = big
+    return out
 
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.parse_args(argv)
-    big, small = pd.read_csv(BIG), pd.read_csv(SMALL)
+    big_all, small = pd.read_csv(BIG), pd.read_csv(SMALL)
+    for label, big in subsets(big_all).items():
+        print(f"\n===== {label}: {len(big)} big-block runs =====")
+        report(big, small)
+
+
+def report(big: pd.DataFrame, small: pd.DataFrame) -> None:
+    """Print the comparison of these big-block runs with the same cases on the family's block."""
     p = paired(big, small)
     pd.set_option("display.width", 250)
     show = ["case"] + [f"{q}_{b}" for q in QUANTITIES[:4] for b in ("small", "big")]

@@ -161,6 +161,11 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     return out
 
 
+def sphere_box(x: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners of the axis-aligned box around spheres at ``x`` (n, 3) with radii ``r`` (n)."""
+    return (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
+
+
 def _piece(ids: np.ndarray, label: np.ndarray, sizes: np.ndarray, body: int, initial: pd.DataFrame,
            solid_fraction: float) -> dict[str, float]:
     """The largest component other than ``body``: grains, bulk volume and extents at the ``initial`` positions."""
@@ -174,7 +179,7 @@ def _piece(ids: np.ndarray, label: np.ndarray, sizes: np.ndarray, body: int, ini
     g = g.loc[sel_ids]
     r = g["radius"].to_numpy(float)
     x = g[["x", "y", "z"]].to_numpy(float)
-    lo, hi = (x - r[:, None]).min(axis=0), (x + r[:, None]).max(axis=0)
+    lo, hi = sphere_box(x, r)
     return {"detached_piece_grains": int(len(sel_ids)),
             "detached_piece_volume_m3": float((4.0 / 3.0 * math.pi * r**3).sum()) / solid_fraction,
             **{f"detached_piece_extent_{a}_m": float(e) for a, e in zip("xyz", hi - lo)},
@@ -208,7 +213,7 @@ def find_chips(bonds: np.ndarray, broken: np.ndarray, atoms: pd.DataFrame, solid
             debris_grains += int(keep.sum())
             debris_solid += float(vol[keep].sum())
             continue
-        lo, hi = (x[sel] - r[sel, None]).min(axis=0), (x[sel] + r[sel, None]).max(axis=0)
+        lo, hi = sphere_box(x[sel], r[sel])
         solid = float(vol[sel].sum())
         cen = (x[sel] * vol[sel, None]).sum(axis=0) / solid
         rows.append([len(rows) + 1, int(sizes[c]), solid, solid / solid_fraction, *(hi - lo), *cen])

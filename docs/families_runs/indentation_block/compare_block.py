@@ -38,8 +38,7 @@ QUANTITIES = ("force_normal_N_peak", "force_normal_N_destructive", "penetration_
 
 def paired(big: pd.DataFrame, small: pd.DataFrame) -> pd.DataFrame:
     """One row per case: both blocks' quantities (``_big``, ``_small``) and which faces the pieces touch."""
-    b = big.assign(case=big["case"].str.removesuffix("_big")) if "variant_case" not in big else big
-    b = b.set_index("case")
+    b = big.set_index("case")  # a variant report's ``case`` is the family case (the run's name is ``variant_case``)
     s = small.set_index("case").loc[b.index]
     out = pd.DataFrame({"cut_spacing_full_mm": b["cut_spacing_full_mm"], "packing_seed": b["packing_seed"]})
     for q in QUANTITIES:
@@ -132,8 +131,7 @@ def report(big: pd.DataFrame, small: pd.DataFrame) -> None:
         print(f"{name} block, mean abs(F_s)/F_n at the destructive force "
               f"{t['lateral_to_normal_ratio_destructive_1'].mean():.2f}; destructive F_n = whole-push peak in "
               f"{int((t['force_normal_N_destructive'] >= t['force_normal_N_peak']).sum())} of {len(t)}")
-    still = big[(big["detached_piece_min_x_m"] * 1e3 <= PIECES.TOUCH_MM)
-                | (big["detached_piece_max_x_m"] * 1e3 >= BLOCKS["big"][0] - PIECES.TOUCH_MM)]
+    still = big[PIECES.touches(big, BLOCKS["big"])["x_end"].to_numpy()]
     print(f"big block without its run(s) whose piece reaches an x end ({', '.join(still['variant_case'])}):\n"
           + family_fits(big.drop(still.index)).round(3).to_string())
     print(f"block x t interaction p: destructive F_n {block_t_interaction(big, nine, 'force_normal_N_destructive'):.2f}, "

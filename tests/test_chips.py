@@ -60,6 +60,46 @@ def test_detachment_is_the_first_break_that_frees_a_piece_of_min_grains():
     assert detachment(bonds, seq, ts, min_grains=3)["detachment_step"] == 100
 
 
+def test_backward_detachment_scan_agrees_with_the_plain_definition_on_random_break_records():
+    """first_detachment_step (final graph once, then bonds put back step by step with a DisjointSet) against
+    _first_detachment_scan (the graph relabelled after every break step) on 300 random records: lattice-like graphs
+    of 30-160 grains with a few loose clusters, 5-100 % of the bonds broken in random order with shared steps, some
+    pairs recorded twice (the first step counts) and some pairs that are no initial bond (ignored), min_grains 2-40.
+    Both must give the same step or both None; the records are made so that both outcomes and late, non-monotone
+    break-offs occur (a piece off early and split below the size later)."""
+    from deckgen.chips import _first_detachment_scan, first_detachment_step
+
+    rng = np.random.default_rng(51)
+    outcomes = {"none": 0, "found": 0, "not_last_step": 0}
+    for _ in range(300):
+        n = int(rng.integers(30, 160))
+        w = int(rng.integers(3, 9))
+        grid = [(i, i + 1) for i in range(1, n) if i % w] + [(i, i + w) for i in range(1, n - w + 1)]
+        extra = [tuple(sorted(rng.choice(np.arange(1, n + 1), 2, replace=False))) for _ in range(n // 10)]
+        loose = [(n + 1 + j, n + 2 + j) for j in range(int(rng.integers(0, 4)))]  # a small loose chain
+        bonds = np.array(grid + extra + loose, dtype=np.int64)
+        k = int(rng.integers(max(1, len(bonds) // 20), len(bonds) + 1))
+        pick = bonds[rng.choice(len(bonds), k, replace=False)]
+        steps = np.sort(rng.integers(1, max(2, k // 2), k)) * 100
+        again = rng.choice(k, k // 8, replace=False)  # recorded a second time, later
+        strays = np.array([[1, n + 20]] * int(rng.integers(0, 3)), dtype=np.int64).reshape(-1, 2)
+        pairs = np.vstack([pick, pick[again][:, ::-1], strays])
+        st = np.concatenate([steps, steps[again] + 1000, rng.integers(1, 50, len(strays)) * 100])
+        mg = int(rng.integers(2, 41))
+        fast, plain = first_detachment_step(bonds, pairs, st, mg), _first_detachment_scan(bonds, pairs, st, mg)
+        assert fast == plain, (n, w, k, mg)
+        outcomes["none" if plain is None else "found"] += 1
+        outcomes["not_last_step"] += plain is not None and plain < st.max()
+    assert min(outcomes.values()) >= 30, outcomes
+    # the recorded example of the test above: the branch off at step 100, split below 3 grains at 200
+    chain = [[i, i + 1] for i in range(1, 10)]
+    bonds = np.array(chain + [[5, 11], [11, 12], [12, 13], [13, 14]])
+    seq = np.array([[5, 11], [12, 13], [10, 9], [9, 8], [8, 7], [7, 6]])
+    assert first_detachment_step(bonds, seq, np.array([100, 200, 300, 310, 320, 330]), 3) == 100
+    assert first_detachment_step(bonds, seq[2:], np.array([300, 310, 320, 330]), 3) is None
+    assert first_detachment_step(bonds, np.zeros((0, 2)), np.zeros(0), 3) is None
+
+
 def test_detachment_gives_the_first_piece_at_its_initial_place():
     """The chain-and-branch graph of the test above, the branch 11-14 laid out along z at x = 8 mm (grain 11 at
     z = 2 mm, then 4, 6, 8 mm; radius 1 mm), and the grains moved afterwards (the piece's place at the start counts).
@@ -220,3 +260,36 @@ def test_chips_of_a_real_cut(tmp_path):
     assert 0.3 * 1.5e-3**2 * math.tan(math.radians(30)) * 2e-3 < s["kinematic_volume_m3"] < 1.5e-3**2 * 2e-3
     assert s["specific_energy_kinematic_J_m3"] == pytest.approx(s["cutter_work_J"] / s["kinematic_volume_m3"])
     assert len(read_bonds(run / "specimen.data")) == spec["derived"]["n_bonds"]
+
+
+def test_bench_detachment_times_both_scans_on_a_recorded_run_folder(tmp_path, capsys):
+    """bench/detachment.py on a folder laid out as the session scripts leave one (run/specimen.data of the reference
+    cut, parsed/broken.csv): its bonds broken one by one in a random order at steps 10, 20, ... The two scans must agree and
+    the line must name the bonds, the broken records and the break-off step; a folder without a broken table is a
+    clear exit naming the fix."""
+    import shutil
+
+    from deckgen.chips import _first_detachment_scan, initial_bonds
+    from deckgen.scriptload import load_script
+
+    root = Path(__file__).resolve().parents[1]
+    bench = load_script(root / "bench" / "detachment.py", "bench_detachment")
+    run = tmp_path / "case" / "run"
+    run.mkdir(parents=True)
+    shutil.copy(root / "tests" / "data" / "runs" / "ref_cut" / "specimen.data", run / "specimen.data")
+    bonds = initial_bonds(run)
+    pick = bonds[np.random.default_rng(7).permutation(len(bonds))]
+    (tmp_path / "case" / "parsed").mkdir()
+    steps = 10 * np.arange(1, len(pick) + 1)
+    pd.DataFrame({"id1": pick[:, 0], "id2": pick[:, 1], "step": steps}).to_csv(
+        tmp_path / "case" / "parsed" / "broken.csv", index=False)
+    expected = _first_detachment_scan(bonds, pick, steps, 5)
+    assert expected is not None and 10 < expected < steps[-1]  # neither the first nor the last break
+    assert bench.main([str(tmp_path / "case"), "--repeat", "1", "--min-grains", "5"]) == 0
+    out = capsys.readouterr().out
+    assert f"{len(bonds)} bonds, {len(pick)} broken at {len(pick)} steps, break-off step {expected};" in out
+    assert "1 runs: plain/backward x" in out
+    (tmp_path / "empty" / "run").mkdir(parents=True)
+    shutil.copy(run / "specimen.data", tmp_path / "empty" / "run" / "specimen.data")
+    with pytest.raises(SystemExit, match="no parsed/broken.parquet or parsed/broken.csv"):
+        bench.main([str(tmp_path / "empty")])

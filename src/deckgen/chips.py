@@ -142,23 +142,89 @@ def detachment(bonds: np.ndarray, broken: pd.DataFrame, ts: pd.DataFrame,
     ids = np.unique(bonds)
     steps = broken["step"].to_numpy(np.int64)
     pairs = broken[["id1", "id2"]].to_numpy(np.int64)
-    for s in np.unique(steps):
+    s = first_detachment_step(bonds, pairs, steps, min_grains)
+    if s is None:
+        return out
+    out["detachment_step"] = s
+    if initial is not None and solid_fraction:
         label, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
-        if (np.delete(sizes, body) >= min_grains).any():
-            out["detachment_step"] = int(s)
-            if initial is not None and solid_fraction:
-                out.update(_piece(ids, label, sizes, body, initial, float(solid_fraction)))
-            upto = ts[ts["step"] <= s]
-            if not len(upto):  # off before the first series row: no force to read
-                return out
-            i = int(np.argmax(upto["force_normal_N"].to_numpy()))
-            out.update(penetration_at_failure_m=float(upto["penetration_m"].iloc[-1]),
-                       force_normal_N_destructive=float(upto["force_normal_N"].iloc[i]),
-                       penetration_at_destructive_m=float(upto["penetration_m"].iloc[i]))
-            if "force_side_N" in upto.columns:
-                out["force_side_N_destructive"] = float(upto["force_side_N"].iloc[i])
-            return out
+        out.update(_piece(ids, label, sizes, body, initial, float(solid_fraction)))
+    upto = ts[ts["step"] <= s]
+    if not len(upto):  # off before the first series row: no force to read
+        return out
+    i = int(np.argmax(upto["force_normal_N"].to_numpy()))
+    out.update(penetration_at_failure_m=float(upto["penetration_m"].iloc[-1]),
+               force_normal_N_destructive=float(upto["force_normal_N"].iloc[i]),
+               penetration_at_destructive_m=float(upto["penetration_m"].iloc[i]))
+    if "force_side_N" in upto.columns:
+        out["force_side_N_destructive"] = float(upto["force_side_N"].iloc[i])
     return out
+
+
+def first_detachment_step(bonds: np.ndarray, pairs: np.ndarray, steps: np.ndarray,
+                          min_grains: int = DETACH_MIN_GRAINS) -> int | None:
+    """The first break step at which a component of the bond graph other than the largest holds at least
+    ``min_grains`` grains (None if none does): ``bonds`` the initial bonds (n, 2), ``pairs`` the broken pairs and
+    ``steps`` their break steps. A pair broken more than once counts from its first step; a pair that is not an
+    initial bond is ignored.
+
+    Bonds only break, so the graph after each break step is the final graph plus the bonds broken later. The scan
+    runs backwards: the final graph's components once (scipy), then the bonds put back one break step at a time
+    with scipy's DisjointSet over the components, keeping the number of components of at least ``min_grains``
+    grains. "Another component has ``min_grains``" is "at least two have" (the largest is the body), so each step is
+    decided without relabelling the graph. One labelling instead of one per break step (:func:`_first_detachment_scan`,
+    the plain definition this is tested against; ``bench/detachment.py`` measures both)."""
+    from scipy.cluster.hierarchy import DisjointSet
+
+    b = np.sort(np.asarray(bonds, dtype=np.int64).reshape(-1, 2), axis=1)
+    pr = np.sort(np.asarray(pairs, dtype=np.int64).reshape(-1, 2), axis=1)
+    st = np.asarray(steps, dtype=np.int64).reshape(-1)
+    if not len(b) or not len(pr):
+        return None
+    records = np.unique(st)[::-1]  # every break step of the record, latest first (as the plain scan tests them)
+    m = max(int(b.max()), int(pr.max())) + 1  # one integer per pair
+    key = pr[:, 0] * m + pr[:, 1]
+    order = np.lexsort((st, key))  # by pair, then step: the first break of each pair first
+    key, st, pr = key[order], st[order], pr[order]
+    first = np.r_[True, key[1:] != key[:-1]]
+    keep = first & np.isin(key, b[:, 0] * m + b[:, 1])
+    st, pr = st[keep], pr[keep]
+    ids = np.unique(b)
+    label, sizes, _ = bond_components(b, pr, ids)
+    weight = {i: int(w) for i, w in enumerate(sizes)}
+    big = int((sizes >= min_grains).sum())
+    back = np.argsort(-st, kind="stable")
+    st, ends = st[back], label[np.searchsorted(ids, pr[back])]  # components of each pair's grains, final graph
+    ds = DisjointSet(range(len(sizes)))
+    found, k = None, 0
+    for s in records:  # the graph just after break step s is decided, then its bonds go back
+        if big >= 2:
+            found = int(s)
+        while k < len(st) and st[k] == s:
+            ra, rc = ds[int(ends[k, 0])], ds[int(ends[k, 1])]
+            k += 1
+            if ra == rc:
+                continue
+            wa, wc = weight.pop(ra), weight.pop(rc)
+            big += int(wa + wc >= min_grains) - int(wa >= min_grains) - int(wc >= min_grains)
+            ds.merge(ra, rc)
+            weight[ds[ra]] = wa + wc
+    return found
+
+
+def _first_detachment_scan(bonds: np.ndarray, pairs: np.ndarray, steps: np.ndarray,
+                           min_grains: int = DETACH_MIN_GRAINS) -> int | None:
+    """:func:`first_detachment_step` by its definition: label the graph after every break step, in order, until a
+    component other than the largest holds ``min_grains`` grains. One labelling per break step (seconds for a
+    30 000-bond block); kept to check the backward scan in tests and ``bench/detachment.py``."""
+    ids = np.unique(bonds)
+    pairs = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    steps = np.asarray(steps, dtype=np.int64).reshape(-1)
+    for s in np.unique(steps):
+        _, sizes, body = bond_components(bonds, pairs[steps <= s], ids)
+        if (np.delete(sizes, body) >= min_grains).any():
+            return int(s)
+    return None
 
 
 def sphere_box(x: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

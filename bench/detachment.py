@@ -40,11 +40,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--min-grains", type=int, default=DETACH_MIN_GRAINS)
     args = ap.parse_args(argv)
+    if args.repeat < 1:
+        ap.error("--repeat must be at least 1")
     ratios = []
     for folder in args.folders:
         bonds = initial_bonds(folder / "run")
         if bonds is None:
-            raise SystemExit(f"{folder}/run: no specimen.data: initial bonds unknown")
+            raise SystemExit(f"{folder}/run: no specimen.data and no step-0 bond sample: initial bonds unknown")
         br = broken_table(folder)
         pairs, steps = br[["id1", "id2"]].to_numpy(), br["step"].to_numpy()
         times: dict[str, list[float]] = {"backward": [], "plain": []}

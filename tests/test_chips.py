@@ -67,10 +67,10 @@ def test_backward_detachment_scan_agrees_with_the_plain_definition_on_random_bre
     pairs recorded twice (the first step counts) and some pairs that are no initial bond (ignored), min_grains 2-40.
     Both must give the same step or both None; the records are made so that both outcomes and late, non-monotone
     break-offs occur (a piece off early and split below the size later)."""
-    from deckgen.chips import _first_detachment_scan, first_detachment_step
+    from deckgen.chips import _first_detachment_scan, bond_components, first_detachment_step
 
     rng = np.random.default_rng(51)
-    outcomes = {"none": 0, "found": 0, "not_last_step": 0}
+    outcomes = {"none": 0, "found": 0, "gone_at_the_end": 0}
     for _ in range(300):
         n = int(rng.integers(30, 160))
         w = int(rng.integers(3, 9))
@@ -82,14 +82,19 @@ def test_backward_detachment_scan_agrees_with_the_plain_definition_on_random_bre
         pick = bonds[rng.choice(len(bonds), k, replace=False)]
         steps = np.sort(rng.integers(1, max(2, k // 2), k)) * 100
         again = rng.choice(k, k // 8, replace=False)  # recorded a second time, later
-        strays = np.array([[1, n + 20]] * int(rng.integers(0, 3)), dtype=np.int64).reshape(-1, 2)
+        # strays: a pair with a grain that does not exist, and pairs of two real grains that are no bond
+        strays = np.array([[1, n + 20]] * int(rng.integers(0, 2)) + [[2, n]] * int(rng.integers(0, 2))
+                          + [[3, n - 1]] * int(rng.integers(0, 2)), dtype=np.int64).reshape(-1, 2)
+        strays = strays[[not ((bonds == p).all(axis=1) | (bonds == p[::-1]).all(axis=1)).any() for p in strays]]
         pairs = np.vstack([pick, pick[again][:, ::-1], strays])
         st = np.concatenate([steps, steps[again] + 1000, rng.integers(1, 50, len(strays)) * 100])
         mg = int(rng.integers(2, 41))
         fast, plain = first_detachment_step(bonds, pairs, st, mg), _first_detachment_scan(bonds, pairs, st, mg)
         assert fast == plain, (n, w, k, mg)
         outcomes["none" if plain is None else "found"] += 1
-        outcomes["not_last_step"] += plain is not None and plain < st.max()
+        if plain is not None:  # the piece found no longer has min_grains at the end: a late split (non-monotone)
+            _, sizes, body = bond_components(bonds, pairs, np.unique(bonds))
+            outcomes["gone_at_the_end"] += not (np.delete(sizes, body) >= mg).any()
     assert min(outcomes.values()) >= 30, outcomes
     # the recorded example of the test above: the branch off at step 100, split below 3 grains at 200
     chain = [[i, i + 1] for i in range(1, 10)]
@@ -98,6 +103,8 @@ def test_backward_detachment_scan_agrees_with_the_plain_definition_on_random_bre
     assert first_detachment_step(bonds, seq, np.array([100, 200, 300, 310, 320, 330]), 3) == 100
     assert first_detachment_step(bonds, seq[2:], np.array([300, 310, 320, 330]), 3) is None
     assert first_detachment_step(bonds, np.zeros((0, 2)), np.zeros(0), 3) is None
+    with pytest.raises(ValueError, match="must not be negative"):
+        first_detachment_step(bonds, np.array([[-1, 2]]), np.array([100]), 3)
 
 
 def test_detachment_gives_the_first_piece_at_its_initial_place():

@@ -181,6 +181,8 @@ def first_detachment_step(bonds: np.ndarray, pairs: np.ndarray, steps: np.ndarra
     st = np.asarray(steps, dtype=np.int64).reshape(-1)
     if not len(b) or not len(pr):
         return None
+    if min(int(b.min()), int(pr.min())) < 0:
+        raise ValueError("grain ids must not be negative (the engines number atoms from 1)")
     records = np.unique(st)[::-1]  # every break step of the record, latest first (as the plain scan tests them)
     m = max(int(b.max()), int(pr.max())) + 1  # one integer per pair
     key = pr[:, 0] * m + pr[:, 1]

@@ -1665,11 +1665,14 @@ def test_recorded_indentation_on_a_larger_block_frees_the_first_piece_and_keeps_
     the family's block), and its volume rises steeply with t (31-39 grains at t 15 mm, 375-1427 at 25). The destructive
     F_n rises +87 % from t 15 to 25 mm (family trend fit, 95 % +12 % to +243 %, p 0.023; seed 000 +100 %) where the same
     nine cases on the family's block give +42 % (-33 % to +237 %, p 0.30): the intervals overlap (block x t p 0.64).
-    Without the one big run whose piece still reaches an x end, +53 % (p 0.034); big over small x0.87 (0.64-1.18)."""
+    Without the one big run whose piece still reaches an x end, +53 % (p 0.034); big over small x0.87 (0.64-1.18).
+    Also the nine concrete D 160 mm cases (session 50) and the nine sandstone D 150 mm ones (session 51)."""
     import pandas as pd
 
     mod = _docs_script(ROOT / "docs" / "families_runs" / "indentation_block" / "compare_block.py")
     big_all, small = pd.read_csv(mod.BIG), pd.read_csv(mod.SMALL)
+    sand = big_all[big_all["rock"] == "sandstone"].reset_index(drop=True)  # session 51, below
+    big_all = big_all[big_all["rock"] == "concrete"].reset_index(drop=True)
     big = big_all[big_all["disc_diameter_full_mm"] == 150].reset_index(drop=True)
     assert len(big) == 9 and set(big["block_height_mm"]) == {30.0} and big["run_completed"].all()
     assert sorted(set(big["n_grains"])) == [8999, 9064, 9083] and (big["grains_inside_cutter_final"] == 0).all()
@@ -1720,7 +1723,9 @@ def test_recorded_indentation_on_a_larger_block_frees_the_first_piece_and_keeps_
     assert big_all["grains_inside_cutter_final"].sum() == 2 == int(none["grains_inside_cutter_final"].iloc[0])
     p160 = mod.paired(d160, small)
     assert int(p160["touches_x_end_big"].sum()) == 0 and int(p160["touches_x_end_small"].sum()) == 4
-    fam = pd.read_csv(mod.BIG.parent / "trends.csv").set_index("trend")
+    from deckgen.families import trend_table
+
+    fam = trend_table("indentation_asymmetric", big_all).set_index("trend")  # the 18 concrete runs (session 50's report)
     ft, fd = fam.loc["fn_destructive_rises_with_t"], fam.loc["fn_destructive_rises_with_d"]
     assert [ft["runs"], ft["change_1"], ft["change_1_ci95_low"], ft["change_1_ci95_high"], ft["p_value"]] == \
         pytest.approx([17, 0.817, 0.321, 1.564, 0.001], abs=1e-3)
@@ -1733,6 +1738,40 @@ def test_recorded_indentation_on_a_larger_block_frees_the_first_piece_and_keeps_
     assert mod.block_t_interaction(big_all, small18, "force_normal_N_destructive") == pytest.approx(0.85, abs=0.005)
     r18 = mod.ratio(mod.paired(big_all.dropna(subset=["detachment_step"]), small), "force_normal_N_destructive")
     assert [r18["geometric_mean"], r18["ci95_low"], r18["ci95_high"], r18["cases"]] == pytest.approx([0.81, 0.67, 0.96, 17], abs=0.01)
+    # session 51: the nine sandstone D 150 mm cases on the larger block (family case files with the larger block only);
+    # their destructive F_n rises +47 % (95 % +0.9 % to +120 %, p 0.046) where the family block gives +8 %; over all 27
+    # larger-block runs (the report's trends.csv, rock x D groups) +87 % (+36 % to +173 %)
+    assert len(sand) == 9 and set(sand["disc_diameter_full_mm"]) == {150} and sand["run_completed"].all()
+    assert sorted(set(sand["n_grains"])) == [8999, 9064, 9083] and int(sand["grains_inside_cutter_final"].sum()) == 1
+    assert sand["wall_s"].between(19 * 60, 25 * 60).all() and sand["detachment_step"].notna().all()
+    for case in sand["case"]:
+        fam = yaml.safe_load((ROOT / "cases" / "indentation_asymmetric" / "reduced" / f"{case}.yaml").read_text())
+        mine = yaml.safe_load((mod.HERE / f"{case}_big.yaml").read_text())
+        assert mine["name"] == f"{case}_big" and (mine["specimen"]["length_mm"], mine["specimen"]["height_mm"]) == (50, 30)
+        for d in (fam, mine):
+            d.pop("name"), d["specimen"].pop("length_mm"), d["specimen"].pop("height_mm")
+        assert mine == fam
+    ps = mod.paired(sand, small)
+    assert [int(ps[f"touches_x_end_{b}"].sum()) for b in ("small", "big")] == [2, 0]
+    nine_s = small.set_index("case").loc[ps["case"]].reset_index()
+    fbs, fss = (mod.family_fits(t).loc["fn_destructive_rises_with_t"] for t in (sand, nine_s))
+    assert [fbs["change_1"], fbs["change_1_ci95_low"], fbs["change_1_ci95_high"], fbs["p_value"]] == pytest.approx(
+        [0.467, 0.009, 1.197, 0.046], abs=1e-3)
+    assert [fss["change_1"], fss["p_value"]] == pytest.approx([0.084, 0.643], abs=1e-3)
+    assert mod.block_t_interaction(sand, nine_s, "force_normal_N_destructive") == pytest.approx(0.33, abs=0.005)
+    rs = mod.ratio(ps, "force_normal_N_destructive")
+    assert [rs["geometric_mean"], rs["ci95_low"], rs["ci95_high"], rs["above_1"]] == pytest.approx([0.75, 0.60, 0.94, 1], abs=0.01)
+    everything = pd.read_csv(mod.BIG)
+    rp = mod.rock_pairs(everything[everything["disc_diameter_full_mm"] == 150]).set_index("quantity")
+    assert rp.loc["removed_volume_m3", "sandstone_higher"] == 7 and rp.loc["removed_volume_m3", "cases"] == 9
+    assert [rp.loc["removed_volume_m3", c] for c in ("geometric_mean", "ci95_low", "ci95_high")] == pytest.approx(
+        [0.992, 0.687, 1.431], abs=1e-3)
+    rp_small = mod.rock_pairs(small[small["case"].isin(
+        [c.replace("sandstone", r) for c in sand["case"] for r in ("sandstone", "concrete")])]).set_index("quantity")
+    assert rp_small.loc["removed_volume_m3", "sandstone_higher"] == 3 and rp_small.loc["removed_volume_m3", "cases"] == 9
+    tr = pd.read_csv(mod.BIG.parent / "trends.csv").set_index("trend").loc["fn_destructive_rises_with_t"]
+    assert [tr["runs"], tr["change_1"], tr["change_1_ci95_low"], tr["change_1_ci95_high"]] == pytest.approx(
+        [26, 0.874, 0.359, 1.728], abs=1e-3) and tr["seed_change_in_ci95"]
 
 
 def test_recorded_linear_family_on_the_held_shell_loses_its_rise_with_p():
@@ -2612,3 +2651,52 @@ def test_909_coarse_reference_splits_a_side_in_its_case_window():
     sp = mod.two_window_spread(packings=nine)
     assert sp.loc["coarse", ["packings", "geometric mean", "95% low", "95% high"]].tolist() == pytest.approx(
         [9, 0.495, 0.293, 0.836], abs=1e-3)
+
+
+def test_recorded_break_off_threshold_moves_the_t15_break_off_and_with_it_the_destructive_rise():
+    """docs/families_runs/shell_held/breakoff_threshold.py (session 51): the break-off recomputed at 10/25/50/100 grains
+    and at a first piece of 0.25/0.5/1/2 t^3 for every recorded indentation run of the family block (36) and the larger
+    block (27). The 25-grain rows are the recorded tables' break-off; a larger threshold never gives an earlier break-off or
+    a lower destructive force. On the family block the destructive rise from t 15 to 25 mm holds at 10 and 25 grains
+    (+62 %, +45 %) and at 0.25-1 t^3 (+59 %, +50 %, +43 %, intervals above 0), and is not resolved at 50 and 100 grains
+    (+34 %, -1.5 %), where the t 15 runs' break-off moves (same force as at 25 grains in 4 of 12 at 100 grains, 11 of 12
+    at t 25). The larger block follows: +87 % at 25 grains, +7 % at 50, -2 % at 100, +53 % at 1 t^3."""
+    import pandas as pd
+
+    mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "breakoff_threshold.py")
+    rows = pd.read_csv(mod.CSV)
+    assert mod.check_25(rows) == 0
+    assert set(rows["threshold"]) == set(mod.THRESHOLDS) and (rows.groupby("run").size() == len(mod.THRESHOLDS)).all()
+    fam = rows[rows["block"] == "family"]
+    assert fam["run"].nunique() == 36
+    # monotone in the threshold: the fixed counts in order, and each t^3 threshold against its grain count
+    for _, g in rows.groupby("run"):
+        g = g.sort_values("min_grains")
+        step = g["detachment_step"].fillna(np.inf).to_numpy()
+        fn = g["force_normal_N_destructive"].fillna(np.inf).to_numpy()
+        assert (step[1:] >= step[:-1]).all() and (fn[1:] >= fn[:-1] - 1e-9).all()  # NaN (none freed) as +inf
+    t3 = rows[rows["threshold"] == "t3x1"]
+    assert (t3["min_grains"] == np.ceil(t3["cut_spacing_m"] ** 3 / t3["grain_bulk_volume_m3"])).all()
+    assert sorted(set(t3.loc[t3["block"] == "family", "min_grains"])) == [32, 33, 76, 77, 148, 149, 150]
+    same = mod.same_as_25(rows).set_index(["block", "threshold"])
+    assert same.loc[("family", "n100"), ["with_breakoff", "same_fn_as_25", "same_at_t15/20/25"]].tolist() == [29, 25, "4/10/11"]
+    assert same.loc[("family", "n10"), "same_fn_as_25"] == 32 and same.loc[("family", "n50"), "with_breakoff"] == 34
+    f = mod.fits(rows).set_index(["block", "rock", "threshold"])
+    expect = {"n10": (36, 0.622, 0.137), "n25": (36, 0.453, 0.009), "n50": (34, 0.337, -0.068), "n100": (29, -0.015, -0.308),
+              "t3x0.25": (36, 0.591, 0.097), "t3x0.5": (36, 0.501, 0.035), "t3x1": (35, 0.431, 0.016),
+              "t3x2": (24, 0.629, -0.015)}
+    for label, (runs, change, low) in expect.items():
+        r = f.loc[("family", "all", label)]
+        assert [r["runs"], r["change_1"], r["ci95_low"]] == pytest.approx([runs, change, low], abs=1e-3), label
+    # the larger block (27 runs): the same pattern; at 100 grains no t 15 mm run keeps its 25-grain force
+    assert rows.loc[rows["block"] == "big", "run"].nunique() == 27
+    assert same.loc[("big", "n100"), ["with_breakoff", "same_at_t15/20/25"]].tolist() == [17, "0/8/6"]
+    big = {"n10": (27, 1.078, 0.507), "n25": (26, 0.874, 0.359), "n50": (21, 0.070, -0.281), "n100": (17, -0.023, -0.430),
+           "t3x1": (24, 0.533, 0.074), "t3x2": (16, 0.129, -0.337)}
+    for label, (runs, change, low) in big.items():
+        r = f.loc[("big", "all", label)]
+        assert [r["runs"], r["change_1"], r["ci95_low"]] == pytest.approx([runs, change, low], abs=1e-3), label
+    assert f.loc[("big", "concrete", "t3x1"), "ci95_low"] == pytest.approx(0.084, abs=1e-3)
+    # the 25-grain fit is the family report's own
+    rec = pd.read_csv(ROOT / "docs" / "families_runs" / "shell_held" / "indentation_3packings" / "trends.csv").set_index("trend")
+    assert f.loc[("family", "all", "n25"), "change_1"] == pytest.approx(rec.loc["fn_destructive_rises_with_t", "change_1"], abs=1e-9)

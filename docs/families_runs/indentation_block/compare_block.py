@@ -1,12 +1,15 @@
 """The reduced indentation cases on a larger block against the same cases on the family's block (session 50).
 
-The nine concrete D 150 mm family cases (t 15/20/25 mm, packings 12345, 202, 303) were run on a block 50 x 25 x 30 mm
+The concrete D 150 and 160 mm family cases (session 50) and the sandstone D 150 mm ones (session 51), t 15/20/25 mm on
+packings 12345, 202, 303, were run on a block 50 x 25 x 30 mm
 (``*_big.yaml`` here: x and z x1.5) besides the family's 33.3 x 25 x 20 mm. This reads the two recorded family tables
 (``report/family_table.csv`` of the big runs, made with ``deckgen.families report --variants``, and
 ``shell_held/indentation_3packings/family_table.csv``) and gives, per case, both blocks' peak and destructive F_n,
 penetration at failure and first piece (grains, volume, extents, and whether its zone touches a face of its block),
-then the big/small ratios (geometric means with a t interval over the nine cases) and the destructive F_n's change
-with t on each block (OLS with the packing as group).
+then the big/small ratios (geometric means with a t interval over the cases) and the destructive F_n's change
+with t on each block (OLS with the packing as group), per rock and D; and, where both rocks ran, sandstone against
+concrete on each block in the matched (D, t, packing) cases (seed 000: "a higher volume of rock fragments was observed
+for sandstone samples").
 
 The packings of the two blocks share no grain position (the larger block is packed anew from the same seed), so a
 ratio mixes the block's effect with a packing's scatter.
@@ -61,12 +64,12 @@ def ratio(p: pd.DataFrame, q: str) -> dict[str, float]:
 
 
 def _d_term(table: pd.DataFrame) -> str:
-    """The disc diameter as a group term of a fit, when the runs have more than one."""
-    return " + C(disc_diameter_full_mm)" if table["disc_diameter_full_mm"].nunique() > 1 else ""
+    """The disc diameter and the rock as group terms of a fit, each when the runs have more than one."""
+    return "".join(f" + C({c})" for c in ("disc_diameter_full_mm", "rock") if table[c].nunique() > 1)
 
 
 def t_change(table: pd.DataFrame, y: str) -> dict[str, float]:
-    """OLS of ``y`` on the seed's t with the packing (and D, when there are two) as group: slope per mm of t, p, and the change from t 15 to 25 mm
+    """OLS of ``y`` on the seed's t with the packing (and D and the rock, when there are two) as group: slope per mm of t, p, and the change from t 15 to 25 mm
     (mean fitted values; NaN where the fitted mean at 15 mm is not positive, so that a ratio has no scale)."""
     f = smf.ols(f"{y} ~ cut_spacing_full_mm + C(packing_seed){_d_term(table)}", data=table).fit()
     m15 = f.predict(table.assign(cut_spacing_full_mm=15)).mean()
@@ -87,7 +90,7 @@ def family_fits(table: pd.DataFrame) -> pd.DataFrame:
 
 def block_t_interaction(big: pd.DataFrame, nine: pd.DataFrame, y: str, log: bool = False) -> float:
     """p of the block x t interaction: does ``y`` (its log with ``log``) change with t differently on the two blocks
-    (OLS over both blocks' runs, y ~ t * block, with D as a group when there are two)?"""
+    (OLS over both blocks' runs, y ~ t * block, with D and the rock as groups when there are two)?"""
     both = pd.concat([nine.assign(block="small"), big.assign(block="big")], ignore_index=True)
     both["y"] = np.log(both[y]) if log else both[y]
     f = smf.ols(f"y ~ cut_spacing_full_mm * C(block){_d_term(both)}", data=both).fit()
@@ -95,11 +98,32 @@ def block_t_interaction(big: pd.DataFrame, nine: pd.DataFrame, y: str, log: bool
 
 
 def subsets(big: pd.DataFrame) -> dict[str, pd.DataFrame]:
-    """The big-block runs by disc diameter, and all of them."""
-    out = {f"D {d:g} mm": g for d, g in big.groupby("disc_diameter_full_mm")}
-    if len(out) > 1:
-        out["both D"] = big
+    """The big-block runs by rock and disc diameter, each rock over both D (where it has two), and all of them."""
+    out = {f"{rock} D {d:g} mm": g for (rock, d), g in big.groupby(["rock", "disc_diameter_full_mm"])}
+    for rock, g in big.groupby("rock"):
+        if g["disc_diameter_full_mm"].nunique() > 1:
+            out[f"{rock}, both D"] = g
+    if big["rock"].nunique() > 1:
+        out["all"] = big
     return out
+
+
+def rock_pairs(table: pd.DataFrame) -> pd.DataFrame:
+    """Sandstone over concrete in the (D, t, packing) cases both rocks ran: per quantity the cases, how many are
+    higher in sandstone, and the geometric mean ratio with its t 95 % interval."""
+    key = ["disc_diameter_full_mm", "cut_spacing_full_mm", "packing_seed"]
+    s = table[table["rock"] == "sandstone"].set_index(key)
+    c = table[table["rock"] == "concrete"].set_index(key)
+    both = s.index.intersection(c.index)
+    rows = []
+    for q in ("removed_volume_m3", "detached_piece_volume_m3", "force_normal_N_destructive", "force_normal_N_peak"):
+        r = np.log(s.loc[both, q] / c.loc[both, q]).dropna()
+        n = len(r)
+        half = stats.t.ppf(0.975, n - 1) * r.std(ddof=1) / math.sqrt(n) if n > 1 else float("nan")
+        rows.append({"quantity": q, "cases": n, "sandstone_higher": int((r > 0).sum()),
+                     "geometric_mean": float(np.exp(r.mean())), "ci95_low": float(np.exp(r.mean() - half)),
+                     "ci95_high": float(np.exp(r.mean() + half))})
+    return pd.DataFrame(rows)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -109,6 +133,13 @@ def main(argv: list[str] | None = None) -> None:
     for label, big in subsets(big_all).items():
         print(f"\n===== {label}: {len(big)} big-block runs =====")
         report(big, small)
+    if big_all["rock"].nunique() > 1:
+        both = big_all.loc[big_all["disc_diameter_full_mm"].isin(
+            big_all.loc[big_all["rock"] == "sandstone", "disc_diameter_full_mm"])]
+        nine = small.set_index("case").loc[both["case"]].reset_index()
+        for name, t in (("small", nine), ("big", both)):
+            print(f"\n===== sandstone / concrete, {name} block (cases both rocks ran on the big block) =====")
+            print(rock_pairs(t).round(3).to_string(index=False))
 
 
 def report(big: pd.DataFrame, small: pd.DataFrame) -> None:

@@ -2659,8 +2659,8 @@ def test_recorded_break_off_threshold_moves_the_t15_break_off_and_with_it_the_de
     block (27). The 25-grain rows are the recorded tables' break-off; a larger threshold never gives an earlier break-off or
     a lower destructive force. On the family block the destructive rise from t 15 to 25 mm holds at 10 and 25 grains
     (+62 %, +45 %) and at 0.25-1 t^3 (+59 %, +50 %, +43 %, intervals above 0), and is not resolved at 50 and 100 grains
-    (+34 %, -1.5 %), where the t 15 runs' break-off moves (same force as at 25 grains in 4 of 12 at 100 grains, 11 of 12
-    at t 25). The larger block follows: +87 % at 25 grains, +7 % at 50, -2 % at 100, +53 % at 1 t^3."""
+    (+34 %, -1.5 %): at 100 grains 6 of 12 t 15 mm runs free no such piece and 2 break off later (same force as at 25
+    grains in 4 of 12 at t 15, 11 of 12 at t 25); the 25-grain forces of the same 29 runs still give +35 %. The larger block follows: +87 % at 25 grains, +7 % at 50, -2 % at 100, +53 % at 1 t^3."""
     import pandas as pd
 
     mod = _docs_script(ROOT / "docs" / "families_runs" / "shell_held" / "breakoff_threshold.py")
@@ -2679,7 +2679,8 @@ def test_recorded_break_off_threshold_moves_the_t15_break_off_and_with_it_the_de
     assert (t3["min_grains"] == np.ceil(t3["cut_spacing_m"] ** 3 / t3["grain_bulk_volume_m3"])).all()
     assert sorted(set(t3.loc[t3["block"] == "family", "min_grains"])) == [32, 33, 76, 77, 148, 149, 150]
     same = mod.same_as_25(rows).set_index(["block", "threshold"])
-    assert same.loc[("family", "n100"), ["with_breakoff", "same_fn_as_25", "same_at_t15/20/25"]].tolist() == [29, 25, "4/10/11"]
+    assert same.loc[("family", "n100"), ["with_breakoff", "same_fn_as_25", "same_at_t15/20/25", "none_at_t15/20/25"]
+                    ].tolist() == [29, 25, "4/10/11", "6/0/1"]
     assert same.loc[("family", "n10"), "same_fn_as_25"] == 32 and same.loc[("family", "n50"), "with_breakoff"] == 34
     f = mod.fits(rows).set_index(["block", "rock", "threshold"])
     expect = {"n10": (36, 0.622, 0.137), "n25": (36, 0.453, 0.009), "n50": (34, 0.337, -0.068), "n100": (29, -0.015, -0.308),
@@ -2690,7 +2691,9 @@ def test_recorded_break_off_threshold_moves_the_t15_break_off_and_with_it_the_de
         assert [r["runs"], r["change_1"], r["ci95_low"]] == pytest.approx([runs, change, low], abs=1e-3), label
     # the larger block (27 runs): the same pattern; at 100 grains no t 15 mm run keeps its 25-grain force
     assert rows.loc[rows["block"] == "big", "run"].nunique() == 27
-    assert same.loc[("big", "n100"), ["with_breakoff", "same_at_t15/20/25"]].tolist() == [17, "0/8/6"]
+    assert same.loc[("big", "n100"), ["with_breakoff", "same_at_t15/20/25", "none_at_t15/20/25"]].tolist() == [17, "0/8/6", "7/1/2"]
+    # dropping the runs without a 100-grain piece alone keeps a rise: the 25-grain forces of the same runs
+    assert [f.loc[(b, "all", "n100"), "change_1_n25_same_runs"] for b in ("family", "big")] == pytest.approx([0.345, 0.774], abs=1e-3)
     big = {"n10": (27, 1.078, 0.507), "n25": (26, 0.874, 0.359), "n50": (21, 0.070, -0.281), "n100": (17, -0.023, -0.430),
            "t3x1": (24, 0.533, 0.074), "t3x2": (16, 0.129, -0.337)}
     for label, (runs, change, low) in big.items():

@@ -30,7 +30,7 @@ CSV = HERE / "breakoff_threshold.csv"
 TABLES = {"family": HERE / "indentation_3packings" / "family_table.csv",
           "big": HERE.parent / "indentation_block" / "report" / "family_table.csv"}
 #: fixed thresholds in grains, and thresholds as the first piece's bulk volume in units of the reduced t^3 (a fixed
-#: grain count is a larger piece relative to t at t 15 mm than at 25 mm: 100 grains are about 3.4 t^3 at t 15 mm and
+#: grain count is a larger piece relative to t at t 15 mm than at 25 mm: 100 grains are about 3.1 t^3 at t 15 mm and
 #: 0.7 t^3 at t 25 mm); labels "n<grains>" and "t3x<fraction>"
 GRAINS = (10, 25, 50, 100)
 T3_FRACTIONS = (0.25, 0.5, 1.0, 2.0)
@@ -99,7 +99,8 @@ def with_threshold(rows: pd.DataFrame, block: str, label: str) -> pd.DataFrame:
 
 
 def fits(rows: pd.DataFrame) -> pd.DataFrame:
-    """The destructive F_n's t-trend (family fit) per block, rock subset and threshold."""
+    """The destructive F_n's t-trend (family fit) per block, rock subset and threshold; beside it the same fit of the
+    25-grain destructive forces on only the runs that free a piece at the threshold (what dropping runs alone does)."""
     from deckgen.families import trend_table
 
     out = []
@@ -111,15 +112,21 @@ def fits(rows: pd.DataFrame) -> pd.DataFrame:
                 if rock != "all" and sub["rock"].nunique() == t["rock"].nunique():
                     continue  # one rock only: the same fit as "all"
                 f = trend_table("indentation_asymmetric", sub).set_index("trend").loc["fn_destructive_rises_with_t"]
+                # the 25-grain forces on the runs that free a piece at this threshold: the change from dropping runs
+                same_runs = with_threshold(rows, block, "n25").assign(_k=t["force_normal_N_destructive"].notna())
+                same_runs = same_runs[same_runs["_k"] & ((same_runs["rock"] == rock) | (rock == "all"))]
+                g = trend_table("indentation_asymmetric", same_runs).set_index("trend").loc["fn_destructive_rises_with_t"]
                 out.append({"block": block, "rock": rock, "threshold": label, "runs": int(f["runs"]),
                             "change_1": f["change_1"], "ci95_low": f["change_1_ci95_low"],
-                            "ci95_high": f["change_1_ci95_high"], "p_value": f["p_value"]})
+                            "ci95_high": f["change_1_ci95_high"], "p_value": f["p_value"],
+                            "change_1_n25_same_runs": g["change_1"], "p_value_n25_same_runs": g["p_value"]})
     return pd.DataFrame(out)
 
 
 def same_as_25(rows: pd.DataFrame) -> pd.DataFrame:
     """Per block and threshold: the grains asked for (range), runs with a break-off, and runs whose destructive F_n
-    is the 25-grain one's (all, and at the seed's t 15 / 20 / 25 mm). A larger threshold can only move the break-off
+    is the 25-grain one's (all, and at the seed's t 15 / 20 / 25 mm), and runs that free no such piece at all (per t;
+    a run neither the same nor without a piece had its break-off moved later). A larger threshold can only move the break-off
     later (a piece of k grains is also one of fewer), so the destructive force can only rise with it, up to the
     whole-push peak."""
     out = []
@@ -130,10 +137,13 @@ def same_as_25(rows: pd.DataFrame) -> pd.DataFrame:
             h = g[g["threshold"] == label].set_index("run")
             fn = h["force_normal_N_destructive"]
             same = pd.Series(np.isclose(fn, ref.loc[fn.index], rtol=1e-12), index=fn.index)
-            by_t = same.groupby(t_full.loc[fn.index].to_numpy()).sum()
+            tt = t_full.loc[fn.index].to_numpy()
+            by_t = same.groupby(tt).sum()
+            never = fn.isna().groupby(tt).sum()
             out.append({"block": block, "threshold": label, "min_grains": f"{h['min_grains'].min()}-{h['min_grains'].max()}",
                         "runs": len(h), "with_breakoff": int(fn.notna().sum()), "same_fn_as_25": int(same.sum()),
-                        "same_at_t15/20/25": "/".join(str(int(by_t.get(t, 0))) for t in (15, 20, 25))})
+                        "same_at_t15/20/25": "/".join(str(int(by_t.get(t, 0))) for t in (15, 20, 25)),
+                        "none_at_t15/20/25": "/".join(str(int(never.get(t, 0))) for t in (15, 20, 25))})
     return pd.DataFrame(out)
 
 

@@ -57,6 +57,13 @@ def last_frame(run_dir: Path) -> pd.DataFrame:
     raise FileNotFoundError(f"{run_dir}: no final.dump.gz or atoms.dump.gz")
 
 
+def _pair_keys(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One integer per row of two sorted (n, 2) id-pair arrays, on a common base, so numpy set operations (isin)
+    compare pairs."""
+    m = max(int(a.max()), int(b.max())) + 1
+    return a[:, 0] * m + a[:, 1], b[:, 0] * m + b[:, 1]
+
+
 def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
     """Connected components of the bond graph among the grains ``ids`` once the ``broken`` pairs are gone (both
     atom-id pairs, any order): the component label of each grain (in the order of ``ids``), the component sizes and
@@ -65,8 +72,8 @@ def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> t
     b = np.sort(np.asarray(bonds, dtype=np.int64).reshape(-1, 2), axis=1)
     if len(broken) and len(b):
         br = np.sort(np.asarray(broken, dtype=np.int64).reshape(-1, 2), axis=1)
-        m = max(int(b.max()), int(br.max())) + 1  # one integer per pair, so numpy does the set difference
-        b = b[~np.isin(b[:, 0] * m + b[:, 1], br[:, 0] * m + br[:, 1])]
+        kb, kbr = _pair_keys(b, br)
+        b = b[~np.isin(kb, kbr)]
     b = b[np.isin(b[:, 0], ids) & np.isin(b[:, 1], ids)] if len(b) else b
     n = len(ids)
     index = pd.Series(np.arange(n), index=ids)
@@ -184,12 +191,11 @@ def first_detachment_step(bonds: np.ndarray, pairs: np.ndarray, steps: np.ndarra
     if min(int(b.min()), int(pr.min())) < 0:
         raise ValueError("grain ids must not be negative (the engines number atoms from 1)")
     records = np.unique(st)[::-1]  # every break step of the record, latest first (as the plain scan tests them)
-    m = max(int(b.max()), int(pr.max())) + 1  # one integer per pair
-    key = pr[:, 0] * m + pr[:, 1]
+    key, bond_key = _pair_keys(pr, b)
     order = np.lexsort((st, key))  # by pair, then step: the first break of each pair first
     key, st, pr = key[order], st[order], pr[order]
     first = np.r_[True, key[1:] != key[:-1]]
-    keep = first & np.isin(key, b[:, 0] * m + b[:, 1])
+    keep = first & np.isin(key, bond_key)
     st, pr = st[keep], pr[keep]
     ids = np.unique(b)
     label, sizes, _ = bond_components(b, pr, ids)

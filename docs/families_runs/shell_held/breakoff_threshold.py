@@ -47,9 +47,8 @@ def compute(roots: list[Path]) -> pd.DataFrame:
     from deckgen.chips import detachment, initial_bonds, initial_positions
 
     names, spacing = {}, {}
-    for block, path in TABLES.items():
-        t = pd.read_csv(path)
-        for run, t_mm in zip(t["variant_case"] if "variant_case" in t.columns else t["case"], t["cut_spacing_mm"]):
+    for block in TABLES:
+        for run, t_mm in recorded(block)["cut_spacing_mm"].items():
             names[run], spacing[run] = block, float(t_mm) * 1e-3
     rows = []
     for root in roots:
@@ -105,6 +104,7 @@ def fits(rows: pd.DataFrame) -> pd.DataFrame:
 
     out = []
     for block in TABLES:
+        n25 = with_threshold(rows, block, "n25")
         for label in THRESHOLDS:
             t = with_threshold(rows, block, label)
             for rock in ("all", *sorted(t["rock"].unique())):
@@ -113,8 +113,7 @@ def fits(rows: pd.DataFrame) -> pd.DataFrame:
                     continue  # one rock only: the same fit as "all"
                 f = trend_table("indentation_asymmetric", sub).set_index("trend").loc["fn_destructive_rises_with_t"]
                 # the 25-grain forces on the runs that free a piece at this threshold: the change from dropping runs
-                same_runs = with_threshold(rows, block, "n25").assign(_k=t["force_normal_N_destructive"].notna())
-                same_runs = same_runs[same_runs["_k"] & ((same_runs["rock"] == rock) | (rock == "all"))]
+                same_runs = n25[t["force_normal_N_destructive"].notna() & ((n25["rock"] == rock) | (rock == "all"))]
                 g = trend_table("indentation_asymmetric", same_runs).set_index("trend").loc["fn_destructive_rises_with_t"]
                 out.append({"block": block, "rock": rock, "threshold": label, "runs": int(f["runs"]),
                             "change_1": f["change_1"], "ci95_low": f["change_1_ci95_low"],

@@ -303,6 +303,28 @@ def test_indentation_kinematics_and_contact(tmp_path, cache):
         assert all(biggest_piece(s) < DETACH_MIN_GRAINS for s in steps)
         assert math.isnan(summ["force_normal_N_destructive"]) and math.isnan(summ["penetration_at_failure_m"])
         assert math.isnan(summ["detached_piece_grains"]) and math.isnan(summ["detached_piece_volume_m3"])
+    # read again at a smaller break-off size (deckgen parse --breakoff-min-grains), and as a case asking for that size:
+    # the first break step that frees a piece of that size, never later than at the case's 25 grains
+    from deckgen.chips import first_detachment_step
+    from deckgen.cli import main
+
+    assert (summ["detachment_min_grains"], summ["detachment_min_grains_source"]) == (DETACH_MIN_GRAINS, "case")
+    small = 5
+    want = first_detachment_step(bonds, br[["id1", "id2"]].to_numpy(np.int64), br["step"].to_numpy(np.int64), small)
+    assert want is not None and biggest_piece(want) >= small
+    assert not len(steps[steps < want]) or biggest_piece(steps[steps < want][-1]) < small
+    assert not math.isfinite(summ["detachment_step"]) or want <= summ["detachment_step"]
+    assert main(["parse", str(out), "--out", str(tmp_path / "p5"), "--breakoff-min-grains", str(small)]) == 0
+    s5 = json.loads((tmp_path / "p5" / "summary.json").read_text())
+    assert (s5["detachment_min_grains"], s5["detachment_min_grains_source"], s5["detachment_step"]) == (small, "parse", want)
+    assert s5["force_normal_N_destructive"] == pytest.approx(ts.loc[ts["step"] <= want, "force_normal_N"].max())
+    assert s5["force_normal_N_peak"] == summ["force_normal_N_peak"] and s5["bonds_broken"] == summ["bonds_broken"]
+    spec_json = json.loads((out / "spec.json").read_text())
+    spec_json["case"]["outputs"]["breakoff_min_grains"] = small
+    (out / "spec.json").write_text(json.dumps(spec_json))
+    s5c = parse_run(out, tmp_path / "p5c")
+    assert (s5c["detachment_min_grains"], s5c["detachment_min_grains_source"], s5c["detachment_step"]) == (small, "case", want)
+    assert main(["parse", str(out), "--out", str(tmp_path / "p1"), "--breakoff-min-grains", "1"]) != 0
 
 
 def test_rotary_path_moves_the_shell_rigidly(tmp_path, cache):

@@ -624,6 +624,11 @@ def test_report_takes_a_renamed_copy_of_a_family_case_only_when_it_is_the_same_c
     t = fam.family_table(idx, [same], same_as={"odc_red_s16_long_bottom_c0_smooth": "odc_red_s16_long_smoothcone"})
     assert list(t["case"]) == ["odc_red_s16_long_smoothcone"] and t["cutter_surface"].iloc[0] == "smooth"
     assert t["force_magnitude_N_mean_cycles_sliding"].iloc[0] == 24.7
+    # a run rendered before a field existed has no key for it: today's default is assumed (spec.resolve_recorded)
+    older = run("odc_red_s16_long_bottom_c0_smooth_old", lambda c: c["outputs"].pop("breakoff_min_grains"))
+    assert "breakoff_min_grains" not in json.loads((older.parent / "spec.json").read_text())["case"]["outputs"]
+    assert list(fam.family_table(idx, [older], same_as={"odc_red_s16_long_bottom_c0_smooth_old": "odc_red_s16_long_smoothcone"})[
+        "case"]) == ["odc_red_s16_long_smoothcone"]
     other = run("odc_red_s16_long_c0_smooth", lambda c: c["kinematics"].update(penetration_at="start"))
     with pytest.raises(ValueError, match=r"differs from .*odc_red_s16_long_smoothcone.yaml in kinematics.penetration_at"):
         fam.family_table(idx, [other], same_as={"odc_red_s16_long_c0_smooth": "odc_red_s16_long_smoothcone"})
@@ -748,6 +753,31 @@ def test_report_of_variants_refuses_unknown_and_doubled_cases(tmp_path, capsys):
     # a longer family case wins over its prefix: odc_red_s11_long_x_y is a variant of odc_red_s11_long
     c = _variant_run(tmp_path, "odc_red_s11_long_nospin_bottom", 20.0, 90)
     assert list(fam.family_table(index, [c], variants=True)["case"]) == ["odc_red_s11_long"]
+
+
+def test_family_table_carries_the_break_off_size_and_refuses_to_mix_two(tmp_path):
+    """Indentation runs record the break-off size they were read at (``detachment_min_grains``); a summary parsed
+    before the size was a field counts as 25, the only size then; non-indentation summaries have none; one table of
+    runs read at two sizes is refused, naming the runs of each."""
+    index = ROOT / "cases" / "indentation_asymmetric" / "index.csv"
+
+    def run(name, **summary):
+        d = tmp_path / name / "parsed"
+        d.mkdir(parents=True)
+        (d / "summary.json").write_text(json.dumps({"case": name, "n_grains": 4033, **summary}))
+        return d
+
+    at25 = run("ind_red_concrete_d150_t15", detachment_step=30000, detachment_min_grains=25)
+    older = run("ind_red_concrete_d150_t20", detachment_step=31000)  # parsed before session 52
+    at50 = run("ind_red_concrete_d150_t25", detachment_step=42000, detachment_min_grains=50)
+    t = fam.family_table(index, [at25, older])
+    assert t["detachment_min_grains"].tolist() == [25, 25] and t["detachment_step"].tolist() == [30000, 31000]
+    assert fam.family_table(index, [at50])["detachment_min_grains"].tolist() == [50]
+    with pytest.raises(ValueError, match=r"different break-off sizes in one table: 25 grains: ind_red_concrete_d150_t15, "
+                                         r"ind_red_concrete_d150_t20; 50 grains: ind_red_concrete_d150_t25 \(fix: parse"):
+        fam.family_table(index, [at25, older, at50])
+    odc = fam.family_table(ROOT / "cases" / "odc" / "index.csv", [run("odc_red_s12", force_magnitude_N_mean_steady=9.0)])
+    assert np.isnan(odc["detachment_min_grains"].iloc[0])
 
 
 def _assert_trend_rows(tr, want: dict) -> None:

@@ -379,6 +379,21 @@ def test_a_finished_cut_reads_again_over_another_steady_window(parsed, tmp_path,
     assert "for cutting runs" in capsys.readouterr().err
 
 
+def test_a_break_off_size_is_refused_outside_indentation_runs(parsed, tmp_path, capsys):
+    """``deckgen parse --breakoff-min-grains N`` is for indentation runs (tests/test_engine.py reads one at two sizes):
+    a linear cut and a platen test are refused in one line naming the run and the fix; a non-indentation summary has
+    no break-off size."""
+    from deckgen.cli import main
+
+    base, _ = parsed["ref_cut"]
+    assert "detachment_min_grains" not in base and "detachment_step" not in base
+    for run, what in ((CUT, "a linear cut"), (UCS, "a ucs test")):
+        assert main(["parse", str(run), "--out", str(tmp_path / run.name), "--breakoff-min-grains", "10"]) != 0
+        err = capsys.readouterr().err
+        assert f"{run}: a break-off size is for indentation runs; this run is {what} (fix: drop it)" in err
+        assert "Traceback" not in err and not (tmp_path / run.name).exists()
+
+
 # ----------------------------------------------------------------------------- column names
 @pytest.mark.parametrize("name", ["ref_ucs", "ref_cut"])
 def test_tables_have_units_in_column_names(parsed, name):

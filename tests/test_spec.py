@@ -76,6 +76,11 @@ def test_case_files_hold_overrides_only(tmp_path):
         ("run:\n  debris_removal_every: 1000\n", "run.debris_removal_every", "a LAMMPS cutting diagnostic"),
         ("run:\n  debris_removal_every: -5\n", "run.debris_removal_every", "greater than or equal to 0"),
         ("bonds:\n  model: flat_joint\nengine: liggghts\n", "bonds.model", "flat_joint is a LAMMPS plugin"),
+        ("outputs:\n  breakoff_min_grains: 1\n", "outputs.breakoff_min_grains", "greater than or equal to 2"),
+        ("outputs:\n  breakoff_min_grains: 50\n", "outputs.breakoff_min_grains",
+         "read for indentation runs only, this case is a ucs test"),
+        ("specimen:\n  kind: cutting_block\noutputs:\n  breakoff_min_grains: 50\n", "outputs.breakoff_min_grains",
+         "read for indentation runs only, this case is kinematics.mode linear"),
         ("specimen:\n  kind: cutting_block\npacking:\n  radius_min_mm: 0.35\n  radius_max_mm: 0.5\n", "cutter.shell_radius_mm",
          "more than half the largest grain radius a packing can have (0.245 mm)"),
     ],
@@ -101,6 +106,25 @@ def test_shell_radius_is_refused_before_packing_only_where_no_packing_can_pass(t
         load_case(write(tmp_path, grains + "cutter:\n  shell_radius_mm: 0.246\n"))
     # the LIGGGHTS decks cut with the STL mesh, not a shell of spheres
     assert load_case(write(tmp_path, grains + "engine: liggghts\nbonds:\n  enabled: false\n")).engine == "liggghts"
+
+
+def test_breakoff_size_is_an_indentation_field_and_old_specs_resolve_to_its_default(tmp_path):
+    """outputs.breakoff_min_grains: any whole number >= 2 on an indentation case; elsewhere only the default (a
+    resolved case carries it); a spec.json case written before the field existed resolves to 25 again."""
+    from deckgen.spec import DETACH_MIN_GRAINS, resolve_recorded, resolved_dict
+
+    indent = "specimen:\n  kind: cutting_block\nkinematics:\n  mode: indentation\n"
+    assert load_case(write(tmp_path, indent + "outputs:\n  breakoff_min_grains: 100\n")).outputs.breakoff_min_grains == 100
+    assert load_case(write(tmp_path, indent)).outputs.breakoff_min_grains == DETACH_MIN_GRAINS == 25
+    assert load_case(write(tmp_path, "outputs:\n  breakoff_min_grains: 25\n")).test == "ucs"  # the default is no claim
+    with pytest.raises(SpecError, match="breakoff_min_grains"):
+        load_case(write(tmp_path, indent + "outputs:\n  breakoff_min_grains: 2.5\n"))
+    full = resolved_dict(load_case(write(tmp_path, indent)))
+    old = json.loads(json.dumps(full))
+    del old["outputs"]["breakoff_min_grains"]
+    assert resolve_recorded(old) == full
+    refused = {**old, "specimen": {**old["specimen"], "height_mm": -1}}
+    assert resolve_recorded(refused) is refused
 
 
 def test_missing_file_and_bad_yaml(tmp_path):

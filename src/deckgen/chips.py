@@ -26,6 +26,7 @@ from scipy.sparse.csgraph import connected_components
 
 from deckgen.datafile import read_bonds
 from deckgen.parse.dump import iter_frames
+from deckgen.spec import DETACH_MIN_GRAINS
 
 CHIP_COLUMNS = ["chip", "n_grains", "solid_volume_m3", "bulk_volume_m3", "extent_x_m", "extent_y_m",
                 "extent_z_m", "centroid_x_m", "centroid_y_m", "centroid_z_m"]
@@ -84,8 +85,9 @@ def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> t
     return label, sizes, int(np.argmax(sizes)) if n else -1
 
 
-#: the smallest piece whose break-off counts as the detachment of an indentation run (:func:`detachment`)
-DETACH_MIN_GRAINS = 25
+#: DETACH_MIN_GRAINS (from deckgen.spec, the schema's default): the smallest piece whose break-off counts as the
+#: detachment of an indentation run (:func:`detachment`) by default; a case sets its own with
+#: ``outputs.breakoff_min_grains``, and ``deckgen parse --breakoff-min-grains`` reads a finished run at another size
 
 
 #: the first piece's columns (:func:`detachment` with the grains' initial positions)
@@ -368,6 +370,16 @@ def kinematic_volume(case: dict[str, Any], derived: dict[str, Any]) -> float:
     return groove_area(prof, cut["radius"], cut["penetration"]) * length
 
 
+def breakoff_min_grains(spec: dict[str, Any]) -> int:
+    """The break-off size of an indentation run: ``derived.breakoff_min_grains`` (set by ``deckgen parse
+    --breakoff-min-grains``) over the case's ``outputs.breakoff_min_grains``; a spec.json written before that field
+    existed was read at :data:`DETACH_MIN_GRAINS`, the only size then."""
+    n = spec["derived"].get("breakoff_min_grains")
+    if n is None:
+        n = spec["case"].get("outputs", {}).get("breakoff_min_grains", DETACH_MIN_GRAINS)
+    return int(n)
+
+
 def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[str, Any],
             min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
     """Chips, removed volume, cutter work and specific energies of a cutting run folder."""
@@ -381,7 +393,10 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
     if derived.get("kinematics_mode") == "indentation":
-        out.update(detachment(bonds, broken, ts, initial=initial_positions(run_dir), solid_fraction=phi))
+        n = breakoff_min_grains(spec)
+        out.update(detachment(bonds, broken, ts, min_grains=n, initial=initial_positions(run_dir), solid_fraction=phi))
+        out.update(detachment_min_grains=n,
+                   detachment_min_grains_source="parse" if "breakoff_min_grains" in derived else "case")
     out.update({
         "cutter_work_J": work,
         "kinematic_volume_m3": v_kin,

@@ -143,7 +143,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 def cmd_parse(args: argparse.Namespace) -> int:
     from deckgen.results import parse_run
 
-    summary = parse_run(Path(args.dir), Path(args.out), steady_window=args.steady_window)
+    summary = parse_run(Path(args.dir), Path(args.out), steady_window=args.steady_window,
+                        breakoff_min_grains=args.breakoff_min_grains)
     keys = [k for k in ("peak_stress_Pa", "youngs_modulus_Pa", "force_normal_N_mean_steady", "force_normal_N_peak",
                         "bonds_broken") if k in summary]
     print(f"{args.dir}: " + ", ".join(f"{k} {summary[k]:.4g}" for k in keys))
@@ -265,6 +266,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--steady-window", nargs=2, type=float, metavar=("START", "END"), default=None,
                    help="cutting runs: read the means over these fractions of the travel instead of the case's "
                         "outputs.steady_window (the summary records the window and its source)")
+    s.add_argument("--breakoff-min-grains", type=int, default=None, metavar="N",
+                   help="indentation runs: read the chip's break-off as the first piece of N grains instead of the "
+                        "case's outputs.breakoff_min_grains (the summary records the size and its source)")
     s.set_defaults(func=cmd_parse)
     s = sub.add_parser("contacts", help="what carries the cutter's load at each dumped step: body, chips or debris")
     s.add_argument("dir", help="run folder (shell cutter)")

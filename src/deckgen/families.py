@@ -854,7 +854,7 @@ TABLE_FIELDS = [
     "largest_chip_extent_y_m", "largest_chip_extent_z_m", "removed_volume_m3", "cutter_work_J", "specific_energy_chips_J_m3",
     "specific_energy_kinematic_J_m3", "grains_inside_cutter_final", "n_grains_deleted_debris",
     "penetration_at_peak_normal_m", "force_normal_N_destructive", "force_side_N_destructive", "penetration_at_destructive_m",
-    "penetration_at_failure_m", "detachment_step", "detached_piece_grains", "detached_piece_volume_m3",
+    "penetration_at_failure_m", "detachment_step", "detachment_min_grains", "detached_piece_grains", "detached_piece_volume_m3",
     *(f"detached_piece_{what}_{a}_m" for what in ("extent", "min", "max") for a in "xyz"),
 ]
 
@@ -896,9 +896,9 @@ def _diff_keys(a: Any, b: Any, path: str = "") -> list[str]:
 
 def _check_same_case(run_spec: dict[str, Any], case_file: Path, where: Path) -> None:
     """Raise unless the run's resolved case (its spec.json) is ``case_file`` apart from the name."""
-    from deckgen.spec import load_case, resolved_dict
+    from deckgen.spec import load_case, resolve_recorded, resolved_dict
 
-    mine = {k: v for k, v in run_spec.get("case", {}).items() if k != "name"}
+    mine = {k: v for k, v in resolve_recorded(run_spec.get("case", {})).items() if k != "name"}
     theirs = {k: v for k, v in resolved_dict(load_case(case_file)).items() if k != "name"}
     diff = _diff_keys(mine, theirs)
     if diff:
@@ -923,7 +923,7 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
 
     import pandas as pd
 
-    from deckgen.spec import Contact, Cutter, CuttingBlock, Kinematics, RunControl
+    from deckgen.spec import DETACH_MIN_GRAINS, Contact, Cutter, CuttingBlock, Kinematics, RunControl
 
     idx = pd.read_csv(index_csv, keep_default_na=False)
     known = set(idx["case"])
@@ -936,6 +936,8 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
             raise ValueError(f"{d}: no summary.json (fix: pass parsed run folders, made by `deckgen parse`)")
         s = json.loads(summary.read_text())
         row = {k: s.get(k, float("nan")) for k in TABLE_FIELDS}
+        if "detachment_step" in s and "detachment_min_grains" not in s:  # parsed before the size was a field: 25
+            row["detachment_min_grains"] = DETACH_MIN_GRAINS
         # the run folder beside parsed/ (the workflow's layout), or parsed/ inside the run folder (`deckgen parse <run>
         # --out <run>/parsed`)
         spec_json = next((p for p in (d.parent / "run" / "spec.json", d.parent / "spec.json") if p.is_file()), None)
@@ -977,10 +979,23 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
     extra = ["variant_case", *(c for c, _, _ in VARIANT_FIELDS)] if variants else []
     runs = pd.DataFrame(rows, columns=["case", *TABLE_FIELDS, "n_shell", "cycles_in_window_1", "lateral_to_normal_ratio_1",
                                        "lateral_to_normal_ratio_destructive_1", *extra])
+    _one_breakoff_size(runs, "variant_case" if variants else "case")
     if variants and runs["case"].duplicated().any():
         dup = sorted(runs.loc[runs["case"].duplicated(keep=False), "variant_case"])
         raise ValueError(f"{', '.join(dup)}: variants of one family case in one report (fix: one variant per report)")
     return _with_index_factors(idx_factors if variants else idx, runs)
+
+
+def _one_breakoff_size(runs: "Any", name: str = "case") -> None:
+    """Refuse a table whose indentation runs were read at different break-off sizes (``detachment_min_grains``):
+    their destructive forces and first pieces answer different questions, so one trend fit must not mix them."""
+    if "detachment_min_grains" not in runs.columns:
+        return
+    sizes = runs.groupby("detachment_min_grains")[name].apply(list)
+    if len(sizes) > 1:
+        raise ValueError("runs read at different break-off sizes in one table: " + "; ".join(
+            f"{int(n)} grains: {', '.join(map(str, c))}" for n, c in sizes.items()) + " (fix: parse them again with one "
+            "`deckgen parse --breakoff-min-grains N`)")
 
 
 def _with_index_factors(idx: "Any", runs: "Any") -> "Any":

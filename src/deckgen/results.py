@@ -98,7 +98,7 @@ UNITLESS_COLUMNS = frozenset({
     "steady_rows", "modulus_fit_points", "bonds_broken_at_peak", "bonds_broken_series", "bonds_broken_at_split",
     "split_crack_bonds", "split_source",
     "bonds_broken_dumps", "run_completed", "kinematics_mode", "damage_source", "mode_source",
-    "steady_window_source", "notes", "log_failure",
+    "steady_window_source", "notes", "log_failure", "detachment_min_grains", "detachment_min_grains_source",
 })
 
 #: Suffixes that carry a unit (SI) in column names; ``_1`` = dimensionless.
@@ -916,14 +916,40 @@ def _steady_window(run_dir: Path, window: Any, test: str) -> tuple[float, float]
     return a, b
 
 
+def _breakoff_min_grains(run_dir: Path, n: Any, spec: dict[str, Any]) -> int:
+    """``n`` as an int, checked by the case schema's rule (:class:`deckgen.spec.Outputs`), for an indentation run;
+    else SpecError naming the run folder and the fix."""
+    from pydantic import ValidationError
+
+    from deckgen.spec import Outputs, SpecError
+
+    mode = spec["derived"].get("kinematics_mode")
+    if spec["case"].get("test") != "cutting" or mode != "indentation":
+        what = f"a {mode} cut" if spec["case"].get("test") == "cutting" else f"a {spec['case'].get('test')} test"
+        raise SpecError(f"{run_dir}: a break-off size is for indentation runs; this run is {what} (fix: drop it)")
+    try:
+        if isinstance(n, bool) or float(n) != int(n):
+            raise ValueError
+        Outputs(breakoff_min_grains=int(n))
+    except (TypeError, ValueError) as exc:  # pydantic's ValidationError is a ValueError
+        why = exc.errors()[0]["msg"] if isinstance(exc, ValidationError) else "not a whole number"
+        raise SpecError(f"{run_dir}: break-off size {n}: {why} (fix: a whole number of grains >= 2, e.g. 25)") from None
+    return int(n)
+
+
 def parse_run(run_dir: str | Path, out_dir: str | Path,
-              steady_window: tuple[float, float] | None = None) -> dict[str, Any]:
+              steady_window: tuple[float, float] | None = None,
+              breakoff_min_grains: int | None = None) -> dict[str, Any]:
     """Parse one run folder into tables in ``out_dir``; return the flat summary dict.
 
     ``steady_window`` (cutting runs): fractions [a, b] of the travel that replace the case's
     ``outputs.steady_window`` for the means, so a finished run can be read again over another window without
     running it again; the summary keeps the window used (``steady_window_start_1``, ``steady_window_end_1``)
     and where it came from (``steady_window_source``: ``case`` or ``parse``).
+
+    ``breakoff_min_grains`` (indentation runs): the smallest piece whose break-off counts as the chip's detachment,
+    in place of the case's ``outputs.breakoff_min_grains``; the summary keeps the size used
+    (``detachment_min_grains``) and where it came from (``detachment_min_grains_source``: ``case`` or ``parse``).
 
     Writes ``timeseries``, ``broken``, ``broken_timeseries`` and ``damage`` (``.parquet`` and
     ``.csv``) and ``summary.json``. Summary keys (all scalars; NaN in the dict, ``null`` in the
@@ -968,6 +994,9 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
     if steady_window is not None:
         a, b = _steady_window(run_dir, steady_window, test)
         spec = {**spec, "derived": {**spec["derived"], "steady_window": [a, b]}}
+    if breakoff_min_grains is not None:
+        n = _breakoff_min_grains(run_dir, breakoff_min_grains, spec)
+        spec = {**spec, "derived": {**spec["derived"], "breakoff_min_grains": n}}
     derived = spec["derived"]
     engine = spec.get("engine") or case.get("engine", "lammps")
     state = _RunState(run_dir)

@@ -483,6 +483,11 @@ class RunControl(_Model):
     )
 
 
+#: the smallest piece whose break-off counts as the chip's detachment of an indentation run, unless the case's
+#: ``outputs.breakoff_min_grains`` says otherwise (deckgen.chips.detachment)
+DETACH_MIN_GRAINS = 25
+
+
 class Outputs(_Model):
     """What the deck writes."""
 
@@ -497,6 +502,13 @@ class Outputs(_Model):
     )
     steady_window: tuple[float, float] = _f(
         (0.4, 0.9), "1", "Steady window for cutting-force means, as fractions of the travel."
+    )
+    breakoff_min_grains: int = _f(
+        DETACH_MIN_GRAINS, "grains",
+        "Indentation runs: the smallest piece (grains held together by intact bonds) whose break-off from the block "
+        "counts as the chip's detachment; the destructive force is the largest normal force up to it. The default "
+        "25 is the recorded families' size; a larger size can only delay the break-off "
+        "(docs/families.md, 'The break-off's size threshold').", ge=2,
     )
 
     @model_validator(mode="after")
@@ -589,6 +601,11 @@ class Case(_Model):
             if all(rest <= 1e-9 for _, rest in rests):
                 raise ValueError("packing.fine_zone: the band fills the whole block (fix: remove fine_zone and give "
                                  "packing.radius_min_mm/radius_max_mm the band's radii)")
+        if self.outputs.breakoff_min_grains != DETACH_MIN_GRAINS and not (
+                isinstance(sp, CuttingBlock) and self.kinematics.mode == "indentation"):
+            what = f"kinematics.mode {self.kinematics.mode}" if isinstance(sp, CuttingBlock) else f"a {self.test} test"
+            raise ValueError(f"outputs.breakoff_min_grains: the chip's break-off is read for indentation runs only, this "
+                             f"case is {what} (fix: remove breakoff_min_grains)")
         if isinstance(sp, CuttingBlock):
             k = self.kinematics
             if k.penetration_mm >= sp.height_mm:
@@ -742,6 +759,17 @@ def resolved_dict(case: Case) -> dict[str, Any]:
     d = case.model_dump(mode="json")
     d["test"] = case.test
     return d
+
+
+def resolve_recorded(case: dict[str, Any]) -> dict[str, Any]:
+    """A run's spec.json ``case`` (the case resolved when the run was rendered) resolved again by today's schema, so
+    that the fields added since then (e.g. ``outputs.breakoff_min_grains``) take their defaults and a comparison with
+    a case file resolved today shows only real differences. Returned unchanged where today's schema refuses it (the
+    comparison then names what differs)."""
+    try:
+        return resolved_dict(Case.model_validate({k: v for k, v in case.items() if k != "test"}))
+    except ValidationError:
+        return case
 
 
 MM = 1e-3

@@ -84,8 +84,9 @@ def check_template(case: dict, seed: int, where: Path) -> str:
     """The name tail of a run of packing ``seed`` whose resolved case (spec.json's ``case``) is packing 303's diagnostic
     case of that tail but for :data:`FREE_FIELDS`; SystemExit naming the run and the fields otherwise."""
     from deckgen.families import _diff_keys
-    from deckgen.spec import load_case, resolved_dict
+    from deckgen.spec import load_case, resolve_recorded, resolved_dict
 
+    case = resolve_recorded(case)  # a run rendered before a field was added has no key for it: today's default
     name = case.get("name", "")
     tail = _tail(name, seed)
     if tail not in REPORTS:

@@ -778,6 +778,20 @@ def test_family_table_carries_the_break_off_size_and_refuses_to_mix_two(tmp_path
         fam.family_table(index, [at25, older, at50])
     odc = fam.family_table(ROOT / "cases" / "odc" / "index.csv", [run("odc_red_s12", force_magnitude_N_mean_steady=9.0)])
     assert np.isnan(odc["detachment_min_grains"].iloc[0])
+    # recorded tables combined: a table written before the size was a field counts as 25 where a run broke off; the
+    # combined table stays as read (no column added), and two sizes are refused
+    import pandas as pd
+
+    t.drop(columns="detachment_min_grains").to_csv(tmp_path / "old.csv", index=False)
+    fam.family_table(index, [at50]).to_csv(tmp_path / "at50.csv", index=False)
+    fam.family_table(index, [at25]).to_csv(tmp_path / "at25.csv", index=False)
+    both = fam.combine_tables([tmp_path / "old.csv", tmp_path / "at25.csv"])
+    assert len(both) == 2 and "detachment_min_grains" in both.columns
+    assert "detachment_min_grains" not in fam.combine_tables([tmp_path / "old.csv"]).columns
+    with pytest.raises(ValueError, match=r"25 grains: ind_red_concrete_d150_t15, ind_red_concrete_d150_t20; 50 grains: "
+                                         r"ind_red_concrete_d150_t25"):
+        fam.combine_tables([tmp_path / "old.csv", tmp_path / "at50.csv"])
+    assert pd.read_csv(tmp_path / "old.csv")["detachment_step"].notna().all()
 
 
 def _assert_trend_rows(tr, want: dict) -> None:

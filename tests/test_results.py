@@ -392,6 +392,31 @@ def test_a_break_off_size_is_refused_outside_indentation_runs(parsed, tmp_path, 
         err = capsys.readouterr().err
         assert f"{run}: a break-off size is for indentation runs; this run is {what} (fix: drop it)" in err
         assert "Traceback" not in err and not (tmp_path / run.name).exists()
+    # a size in spec.json that is not a whole number >= 2 (a hand-edited spec.json: the schema refuses it in a case
+    # file) is one line naming spec.json, the field and the fix; the reference cut's folder dressed as an indentation
+    # run, which is refused before any table is read
+    import shutil
+
+    from deckgen.results import _whole_size
+
+    run = tmp_path / "dressed"
+    shutil.copytree(CUT, run)
+    spec = _spec(CUT)
+    spec["derived"]["kinematics_mode"] = "indentation"
+    for bad, why in ((None, "not a whole number"), ("abc", "not a whole number"), (1, "Input should be greater than or equal to 2"),
+                     (25.7, "not a whole number"), (float("inf"), "not a whole number")):
+        spec["case"]["outputs"]["breakoff_min_grains"] = bad
+        (run / "spec.json").write_text(json.dumps(spec))
+        assert main(["parse", str(run), "--out", str(tmp_path / "d")]) != 0
+        err = capsys.readouterr().err
+        assert f"{run / 'spec.json'}: case.outputs.breakoff_min_grains {bad!r}: {why} (fix: parse with" in err, err
+        assert "Traceback" not in err and not (tmp_path / "d").exists()
+    assert main(["parse", str(run), "--out", str(tmp_path / "d"), "--breakoff-min-grains", "1"]) != 0
+    assert "break-off size 1: Input should be greater than or equal to 2 (fix: a whole number" in capsys.readouterr().err
+    assert [_whole_size(v) for v in (2, 25.0, "30")] == [2, 25, 30]
+    for bad in (True, float("nan"), float("inf"), 2.5, [3]):
+        with pytest.raises(ValueError):
+            _whole_size(bad)
 
 
 # ----------------------------------------------------------------------------- column names

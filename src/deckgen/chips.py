@@ -85,9 +85,9 @@ def bond_components(bonds: np.ndarray, broken: np.ndarray, ids: np.ndarray) -> t
     return label, sizes, int(np.argmax(sizes)) if n else -1
 
 
-#: DETACH_MIN_GRAINS (from deckgen.spec, the schema's default): the smallest piece whose break-off counts as the
-#: detachment of an indentation run (:func:`detachment`) by default; a case sets its own with
-#: ``outputs.breakoff_min_grains``, and ``deckgen parse --breakoff-min-grains`` reads a finished run at another size
+# DETACH_MIN_GRAINS (imported from deckgen.spec, the schema's default) is the smallest piece whose break-off counts as
+# the detachment of an indentation run (detachment()) by default; a case sets its own with outputs.breakoff_min_grains,
+# and `deckgen parse --breakoff-min-grains` reads a finished run at another size
 
 
 #: the first piece's columns (:func:`detachment` with the grains' initial positions)
@@ -370,14 +370,16 @@ def kinematic_volume(case: dict[str, Any], derived: dict[str, Any]) -> float:
     return groove_area(prof, cut["radius"], cut["penetration"]) * length
 
 
-def breakoff_min_grains(spec: dict[str, Any]) -> int:
-    """The break-off size of an indentation run: ``derived.breakoff_min_grains`` (set by ``deckgen parse
-    --breakoff-min-grains``) over the case's ``outputs.breakoff_min_grains``; a spec.json written before that field
-    existed was read at :data:`DETACH_MIN_GRAINS`, the only size then."""
-    n = spec["derived"].get("breakoff_min_grains")
-    if n is None:
-        n = spec["case"].get("outputs", {}).get("breakoff_min_grains", DETACH_MIN_GRAINS)
-    return int(n)
+def breakoff_min_grains(spec: dict[str, Any]) -> tuple[int, str]:
+    """The break-off size of an indentation run and its source: ``derived.breakoff_min_grains`` as
+    :func:`deckgen.results.parse_run` checked and set it (from ``deckgen parse --breakoff-min-grains``, the case's
+    ``outputs.breakoff_min_grains`` or, for a spec.json written before that field existed, the default 25); else,
+    called without parse_run, the case's field or the default unchecked."""
+    d = spec["derived"]
+    if "breakoff_min_grains" in d:
+        return int(d["breakoff_min_grains"]), str(d.get("breakoff_min_grains_source", "parse"))
+    n = spec["case"].get("outputs", {}).get("breakoff_min_grains")
+    return (int(n), "case") if n is not None else (DETACH_MIN_GRAINS, "default")
 
 
 def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[str, Any],
@@ -393,10 +395,9 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
     if derived.get("kinematics_mode") == "indentation":
-        n = breakoff_min_grains(spec)
+        n, source = breakoff_min_grains(spec)
         out.update(detachment(bonds, broken, ts, min_grains=n, initial=initial_positions(run_dir), solid_fraction=phi))
-        out.update(detachment_min_grains=n,
-                   detachment_min_grains_source="parse" if "breakoff_min_grains" in derived else "case")
+        out.update(detachment_min_grains=n, detachment_min_grains_source=source)
     out.update({
         "cutter_work_J": work,
         "kinematic_volume_m3": v_kin,

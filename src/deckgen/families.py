@@ -986,6 +986,23 @@ def family_table(index_csv: str | Path, parsed_dirs: list[str | Path], variants:
     return _with_index_factors(idx_factors if variants else idx, runs)
 
 
+def _breakoff_sizes(table: "Any") -> "Any":
+    """Each row's break-off size (case, detachment_min_grains) of a family table read from CSV: its own column, or in
+    a table written before the size was a field 25 (the only size then) where the run has a break-off."""
+    import numpy as np
+    import pandas as pd
+
+    from deckgen.spec import DETACH_MIN_GRAINS
+
+    def num(col: str) -> "Any":
+        return pd.to_numeric(table[col], errors="coerce") if col in table.columns else pd.Series(np.nan, index=table.index)
+
+    size = num("detachment_min_grains")
+    if "detachment_min_grains" not in table.columns:
+        size = size.mask(num("detachment_step").notna(), DETACH_MIN_GRAINS)
+    return pd.DataFrame({"case": table["case"], "detachment_min_grains": size})
+
+
 def _one_breakoff_size(runs: "Any", name: str = "case") -> None:
     """Refuse a table whose indentation runs were read at different break-off sizes (``detachment_min_grains``):
     their destructive forces and first pieces answer different questions, so one trend fit must not mix them."""
@@ -1302,6 +1319,8 @@ def combine_tables(tables: list[str | Path], index_csv: str | Path | None = None
 
     frames = [pd.read_csv(t, keep_default_na=False) for t in tables]
     table = pd.concat(frames, ignore_index=True).drop_duplicates("case", keep="last").reset_index(drop=True)
+    _one_breakoff_size(pd.concat([_breakoff_sizes(f) for f in frames], ignore_index=True)
+                       .drop_duplicates("case", keep="last"))  # checked beside the table, which stays as read
     if index_csv is None:
         return table
     idx = pd.read_csv(index_csv, keep_default_na=False)

@@ -134,7 +134,9 @@ def _forces_x(summary: dict[str, Any], ts: pd.DataFrame, path: Path) -> Path:
         ax.set_xlabel("penetration (mm)")
         fail = summary.get("penetration_at_failure_m")
         if _finite(fail):  # the first piece of the block off (deckgen.chips.detachment)
-            ax.axvline(fail * 1e3, color="0.4", ls="--", lw=0.8, label="first piece off")
+            n = summary.get("detachment_min_grains")
+            ax.axvline(fail * 1e3, color="0.4", ls="--", lw=0.8,
+                       label=f"first piece of {int(n)}+ grains off" if _finite(n) else "first piece off")
     else:
         x = ts["cutter_x_m"].to_numpy() * 1e3
         ax.set_xlabel("cutter centre x (mm)")

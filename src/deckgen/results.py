@@ -916,25 +916,50 @@ def _steady_window(run_dir: Path, window: Any, test: str) -> tuple[float, float]
     return a, b
 
 
-def _breakoff_min_grains(run_dir: Path, n: Any, spec: dict[str, Any]) -> int:
-    """``n`` as an int, checked by the case schema's rule (:class:`deckgen.spec.Outputs`), for an indentation run;
-    else SpecError naming the run folder and the fix."""
+def _whole_size(n: Any) -> int:
+    """``n`` as a break-off size by the case schema's rule (:class:`deckgen.spec.Outputs`); ValueError saying why."""
     from pydantic import ValidationError
 
-    from deckgen.spec import Outputs, SpecError
+    from deckgen.spec import Outputs
 
-    mode = spec["derived"].get("kinematics_mode")
-    if spec["case"].get("test") != "cutting" or mode != "indentation":
-        what = f"a {mode} cut" if spec["case"].get("test") == "cutting" else f"a {spec['case'].get('test')} test"
-        raise SpecError(f"{run_dir}: a break-off size is for indentation runs; this run is {what} (fix: drop it)")
     try:
         if isinstance(n, bool) or float(n) != int(n):
-            raise ValueError
+            raise ValueError("not a whole number")
         Outputs(breakoff_min_grains=int(n))
-    except (TypeError, ValueError) as exc:  # pydantic's ValidationError is a ValueError
-        why = exc.errors()[0]["msg"] if isinstance(exc, ValidationError) else "not a whole number"
-        raise SpecError(f"{run_dir}: break-off size {n}: {why} (fix: a whole number of grains >= 2, e.g. 25)") from None
+    except ValidationError as exc:
+        raise ValueError(exc.errors()[0]["msg"]) from None
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError("not a whole number") from None
     return int(n)
+
+
+def _breakoff_size(run_dir: Path, spec: dict[str, Any], n: Any) -> tuple[int, str]:
+    """The break-off size of a run and where it comes from: ``n`` (``deckgen parse --breakoff-min-grains``, ``parse``),
+    else the case's ``outputs.breakoff_min_grains`` in spec.json (``case``), else, for a spec.json written before the
+    field existed, :data:`deckgen.spec.DETACH_MIN_GRAINS` (``default``, the only size then). SpecError naming the run
+    folder or spec.json and the fix: a size given for a run that is not an indentation run, or one that is not a whole
+    number >= 2."""
+    from deckgen.spec import DETACH_MIN_GRAINS, SpecError
+
+    mode = spec["derived"].get("kinematics_mode")
+    test = spec["case"].get("test")
+    if n is not None:
+        if test != "cutting" or mode != "indentation":
+            what = f"a {mode} cut" if test == "cutting" else f"a {test} test"
+            raise SpecError(f"{run_dir}: a break-off size is for indentation runs; this run is {what} (fix: drop it)")
+        try:
+            return _whole_size(n), "parse"
+        except ValueError as exc:
+            raise SpecError(f"{run_dir}: break-off size {n}: {exc} (fix: a whole number of grains >= 2, e.g. 25)") from None
+    outputs = spec["case"].get("outputs", {})
+    if "breakoff_min_grains" not in outputs:
+        return DETACH_MIN_GRAINS, "default"
+    try:
+        return _whole_size(outputs["breakoff_min_grains"]), "case"
+    except ValueError as exc:
+        raise SpecError(f"{run_dir / 'spec.json'}: case.outputs.breakoff_min_grains {outputs['breakoff_min_grains']!r}: "
+                        f"{exc} (fix: parse with --breakoff-min-grains N, or a whole number >= 2 in the case file and "
+                        "render again)") from None
 
 
 def parse_run(run_dir: str | Path, out_dir: str | Path,
@@ -949,7 +974,8 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
 
     ``breakoff_min_grains`` (indentation runs): the smallest piece whose break-off counts as the chip's detachment,
     in place of the case's ``outputs.breakoff_min_grains``; the summary keeps the size used
-    (``detachment_min_grains``) and where it came from (``detachment_min_grains_source``: ``case`` or ``parse``).
+    (``detachment_min_grains``) and where it came from (``detachment_min_grains_source``: ``case``, ``parse``, or
+    ``default`` for a spec.json written before the field existed, read at 25 grains as every run then was).
 
     Writes ``timeseries``, ``broken``, ``broken_timeseries`` and ``damage`` (``.parquet`` and
     ``.csv``) and ``summary.json``. Summary keys (all scalars; NaN in the dict, ``null`` in the
@@ -994,9 +1020,9 @@ def parse_run(run_dir: str | Path, out_dir: str | Path,
     if steady_window is not None:
         a, b = _steady_window(run_dir, steady_window, test)
         spec = {**spec, "derived": {**spec["derived"], "steady_window": [a, b]}}
-    if breakoff_min_grains is not None:
-        n = _breakoff_min_grains(run_dir, breakoff_min_grains, spec)
-        spec = {**spec, "derived": {**spec["derived"], "breakoff_min_grains": n}}
+    if breakoff_min_grains is not None or spec["derived"].get("kinematics_mode") == "indentation":
+        n, source = _breakoff_size(run_dir, spec, breakoff_min_grains)
+        spec = {**spec, "derived": {**spec["derived"], "breakoff_min_grains": n, "breakoff_min_grains_source": source}}
     derived = spec["derived"]
     engine = spec.get("engine") or case.get("engine", "lammps")
     state = _RunState(run_dir)

@@ -764,8 +764,9 @@ def resolved_dict(case: Case) -> dict[str, Any]:
 def resolve_recorded(case: dict[str, Any]) -> dict[str, Any]:
     """A run's spec.json ``case`` (the case resolved when the run was rendered) resolved again by today's schema, so
     that the fields added since then (e.g. ``outputs.breakoff_min_grains``) take their defaults and a comparison with
-    a case file resolved today shows only real differences. Returned unchanged where today's schema refuses it (the
-    comparison then names what differs)."""
+    a case file resolved today shows only real differences. All or nothing: where today's schema refuses any field of
+    it (e.g. one since removed), the case comes back unchanged, and a comparison then also names the fields added
+    since."""
     try:
         return resolved_dict(Case.model_validate({k: v for k, v in case.items() if k != "test"}))
     except ValidationError:

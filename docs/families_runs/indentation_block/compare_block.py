@@ -1,7 +1,7 @@
 """The reduced indentation cases on a larger block against the same cases on the family's block (session 50).
 
-The concrete D 150 and 160 mm family cases (session 50) and the sandstone D 150 mm ones (session 51), t 15/20/25 mm on
-packings 12345, 202, 303, were run on a block 50 x 25 x 30 mm
+The concrete D 150 and 160 mm family cases (session 50) and the sandstone D 150 (session 51) and D 160 mm ones
+(session 52), t 15/20/25 mm on packings 12345, 202, 303, were run on a block 50 x 25 x 30 mm
 (``*_big.yaml`` here: x and z x1.5) besides the family's 33.3 x 25 x 20 mm. This reads the two recorded family tables
 (``report/family_table.csv`` of the big runs, made with ``deckgen.families report --variants``, and
 ``shell_held/indentation_3packings/family_table.csv``) and gives, per case, both blocks' peak and destructive F_n,
@@ -9,7 +9,8 @@ penetration at failure and first piece (grains, volume, extents, and whether its
 then the big/small ratios (geometric means with a t interval over the cases) and the destructive F_n's change
 with t on each block (OLS with the packing as group), per rock and D; and, where both rocks ran, sandstone against
 concrete on each block in the matched (D, t, packing) cases (seed 000: "a higher volume of rock fragments was observed
-for sandstone samples").
+for sandstone samples"), and, per rock, D 160 against D 150 mm in the matched (t, packing) cases (seed 000: the
+destructive force rises with D).
 
 The packings of the two blocks share no grain position (the larger block is packed anew from the same seed), so a
 ratio mixes the block's effect with a packing's scatter.
@@ -108,22 +109,39 @@ def subsets(big: pd.DataFrame) -> dict[str, pd.DataFrame]:
     return out
 
 
-def rock_pairs(table: pd.DataFrame) -> pd.DataFrame:
-    """Sandstone over concrete in the (D, t, packing) cases both rocks ran: per quantity the cases, how many are
-    higher in sandstone, and the geometric mean ratio with its t 95 % interval."""
-    key = ["disc_diameter_full_mm", "cut_spacing_full_mm", "packing_seed"]
-    s = table[table["rock"] == "sandstone"].set_index(key)
-    c = table[table["rock"] == "concrete"].set_index(key)
-    both = s.index.intersection(c.index)
+#: the factors that name a case of the family, and the quantities compared between matched cases
+CASE_FACTORS = ("rock", "disc_diameter_full_mm", "cut_spacing_full_mm", "packing_seed")
+PAIR_QUANTITIES = ("removed_volume_m3", "detached_piece_volume_m3", "force_normal_N_destructive", "force_normal_N_peak")
+
+
+def matched_ratios(table: pd.DataFrame, factor: str, high, low) -> pd.DataFrame:
+    """``factor`` = ``high`` over ``low`` in the cases that ran at both and agree in every other factor: per quantity
+    the cases, how many are higher at ``high``, and the geometric mean ratio with its t 95 % interval."""
+    key = [c for c in CASE_FACTORS if c != factor]
+    h = table[table[factor] == high].set_index(key)
+    lo = table[table[factor] == low].set_index(key)
+    both = h.index.intersection(lo.index)
     rows = []
-    for q in ("removed_volume_m3", "detached_piece_volume_m3", "force_normal_N_destructive", "force_normal_N_peak"):
-        r = np.log(s.loc[both, q] / c.loc[both, q]).dropna()
+    for q in PAIR_QUANTITIES:
+        r = np.log(h.loc[both, q] / lo.loc[both, q]).dropna()
         n = len(r)
         half = stats.t.ppf(0.975, n - 1) * r.std(ddof=1) / math.sqrt(n) if n > 1 else float("nan")
-        rows.append({"quantity": q, "cases": n, "sandstone_higher": int((r > 0).sum()),
+        rows.append({"quantity": q, "cases": n, "higher": int((r > 0).sum()),
                      "geometric_mean": float(np.exp(r.mean())), "ci95_low": float(np.exp(r.mean() - half)),
                      "ci95_high": float(np.exp(r.mean() + half))})
     return pd.DataFrame(rows)
+
+
+def rock_pairs(table: pd.DataFrame) -> pd.DataFrame:
+    """Sandstone over concrete in the (D, t, packing) cases both rocks ran (``sandstone_higher``: cases higher in
+    sandstone)."""
+    return matched_ratios(table, "rock", "sandstone", "concrete").rename(columns={"higher": "sandstone_higher"})
+
+
+def d_pairs(table: pd.DataFrame) -> pd.DataFrame:
+    """D 160 over D 150 mm in the (rock, t, packing) cases run with both discs (``d160_higher``: cases higher at
+    D 160 mm; seed 000: the destructive force rises with D)."""
+    return matched_ratios(table, "disc_diameter_full_mm", 160, 150).rename(columns={"higher": "d160_higher"})
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -140,6 +158,12 @@ def main(argv: list[str] | None = None) -> None:
         for name, t in (("small", nine), ("big", both)):
             print(f"\n===== sandstone / concrete, {name} block (cases both rocks ran on the big block) =====")
             print(rock_pairs(t).round(3).to_string(index=False))
+    for rock, g in big_all.groupby("rock"):
+        if g["disc_diameter_full_mm"].nunique() > 1:
+            nine = small.set_index("case").loc[g["case"]].reset_index()
+            for name, t in (("small", nine), ("big", g)):
+                print(f"\n===== {rock}, D 160 / D 150 mm, {name} block (cases run with both discs on the big block) =====")
+                print(d_pairs(t).round(3).to_string(index=False))
 
 
 def report(big: pd.DataFrame, small: pd.DataFrame) -> None:

@@ -12,7 +12,7 @@ Two steps. With ``--runs`` it reads run folders (each ``NAME/run`` with specimen
 writes ``breakoff_threshold.csv`` here (one row per run and threshold). Without it, it reads that CSV and prints the
 counts and fits the docs quote; the 25-grain rows must reproduce the recorded family tables' break-off exactly.
 
-    python docs/families_runs/shell_held/breakoff_threshold.py --runs /work/runs49 /work/runs50 /work/runs51
+    python docs/families_runs/shell_held/breakoff_threshold.py --runs /work/runs49 /work/runs50 /work/runs51 /work/runs52
     python docs/families_runs/shell_held/breakoff_threshold.py
 """
 from __future__ import annotations

@@ -370,21 +370,11 @@ def kinematic_volume(case: dict[str, Any], derived: dict[str, Any]) -> float:
     return groove_area(prof, cut["radius"], cut["penetration"]) * length
 
 
-def breakoff_min_grains(spec: dict[str, Any]) -> tuple[int, str]:
-    """The break-off size of an indentation run and its source: ``derived.breakoff_min_grains`` as
-    :func:`deckgen.results.parse_run` checked and set it (from ``deckgen parse --breakoff-min-grains``, the case's
-    ``outputs.breakoff_min_grains`` or, for a spec.json written before that field existed, the default 25); else,
-    called without parse_run, the case's field or the default unchecked."""
-    d = spec["derived"]
-    if "breakoff_min_grains" in d:
-        return int(d["breakoff_min_grains"]), str(d.get("breakoff_min_grains_source", "parse"))
-    n = spec["case"].get("outputs", {}).get("breakoff_min_grains")
-    return (int(n), "case") if n is not None else (DETACH_MIN_GRAINS, "default")
-
-
 def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[str, Any],
             min_grains: int = 2) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """Chips, removed volume, cutter work and specific energies of a cutting run folder."""
+    """Chips, removed volume, cutter work and specific energies of a cutting run folder. ``spec`` as
+    :func:`deckgen.results.parse_run` passes it: for an indentation run its ``derived`` holds the checked break-off size
+    and its source (``breakoff_min_grains``, ``breakoff_min_grains_source``; results._breakoff_size)."""
     derived = spec["derived"]
     bonds = initial_bonds(run_dir)
     if bonds is None:
@@ -395,9 +385,9 @@ def analyse(run_dir: Path, broken: pd.DataFrame, ts: pd.DataFrame, spec: dict[st
     work = cutter_work(ts, float(derived["cutter"].get("spin_rate", 0.0)), float(derived["cutter"].get("yaw_rate", 0.0)))
     v_kin = kinematic_volume(spec["case"], derived)
     if derived.get("kinematics_mode") == "indentation":
-        n, source = breakoff_min_grains(spec)
+        n = int(derived["breakoff_min_grains"])
         out.update(detachment(bonds, broken, ts, min_grains=n, initial=initial_positions(run_dir), solid_fraction=phi))
-        out.update(detachment_min_grains=n, detachment_min_grains_source=source)
+        out.update(detachment_min_grains=n, detachment_min_grains_source=derived["breakoff_min_grains_source"])
     out.update({
         "cutter_work_J": work,
         "kinematic_volume_m3": v_kin,

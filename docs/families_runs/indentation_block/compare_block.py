@@ -55,6 +55,11 @@ def paired(big: pd.DataFrame, small: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
+def family_rows(small: pd.DataFrame, big: pd.DataFrame) -> pd.DataFrame:
+    """The family block's runs of the cases in ``big`` (its ``case`` column), in that order."""
+    return small.set_index("case").loc[big["case"]].reset_index()
+
+
 def ratio(p: pd.DataFrame, q: str) -> dict[str, float]:
     """Geometric mean of big/small over the cases with its t 95 % interval, and how many are above 1."""
     r = np.log(p[f"{q}_big"] / p[f"{q}_small"]).dropna()  # a run without a break-off has no destructive force
@@ -154,13 +159,13 @@ def main(argv: list[str] | None = None) -> None:
     if big_all["rock"].nunique() > 1:
         both = big_all.loc[big_all["disc_diameter_full_mm"].isin(
             big_all.loc[big_all["rock"] == "sandstone", "disc_diameter_full_mm"])]
-        nine = small.set_index("case").loc[both["case"]].reset_index()
+        nine = family_rows(small, both)
         for name, t in (("small", nine), ("big", both)):
             print(f"\n===== sandstone / concrete, {name} block (cases both rocks ran on the big block) =====")
             print(rock_pairs(t).round(3).to_string(index=False))
     for rock, g in big_all.groupby("rock"):
         if g["disc_diameter_full_mm"].nunique() > 1:
-            nine = small.set_index("case").loc[g["case"]].reset_index()
+            nine = family_rows(small, g)
             for name, t in (("small", nine), ("big", g)):
                 print(f"\n===== {rock}, D 160 / D 150 mm, {name} block (cases run with both discs on the big block) =====")
                 print(d_pairs(t).round(3).to_string(index=False))
@@ -180,7 +185,7 @@ def report(big: pd.DataFrame, small: pd.DataFrame) -> None:
     for block in ("small", "big"):
         print(f"{block} block, first pieces touching: " + ", ".join(
             f"{c} {int(p[f'touches_{c}_{block}'].sum())}" for c in ("free_face", "top", "x_end", "base", "back")))
-    nine = small.set_index("case").loc[p["case"]].reset_index()
+    nine = family_rows(small, p)
     for name, t in (("small", nine), ("big", big)):
         print(f"{name} block, family trend fits (rock x D groups):\n{family_fits(t).round(3).to_string()}")
         print(f"{name} block, mean abs(F_s)/F_n at the destructive force "
